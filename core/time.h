@@ -1,0 +1,23 @@
+// Timestamps are int64 nanoseconds everywhere inside evfs: exact for every DAVIS clock (µs) and
+// every decimal seconds value with up to 9 digits, and cheap to compare.
+#ifndef EVFS_CORE_TIME_H_
+#define EVFS_CORE_TIME_H_
+
+#include <cmath>
+#include <cstdint>
+
+namespace evfs {
+
+constexpr int64_t kNanosecondsPerSecond = 1000000000;
+
+inline double NanosecondsToSeconds(int64_t t_ns) {
+  return static_cast<double>(t_ns) / static_cast<double>(kNanosecondsPerSecond);
+}
+
+inline int64_t SecondsToNanoseconds(double t_s) {
+  return static_cast<int64_t>(std::llround(t_s * static_cast<double>(kNanosecondsPerSecond)));
+}
+
+}  // namespace evfs
+
+#endif  // EVFS_CORE_TIME_H_

@@ -1,0 +1,49 @@
+#include "core/video.h"
+
+#include <algorithm>
+#include <cstdlib>
+
+#include "core/time.h"
+
+namespace evfs {
+
+Video::Video(int height, int width, int num_frames)
+    : height_(height),
+      width_(width),
+      data_(static_cast<size_t>(height) * width * num_frames, 0.0),
+      timestamps_ns_(num_frames, 0) {}
+
+double Video::timestamp_s(int t) const { return NanosecondsToSeconds(timestamps_ns_[t]); }
+
+void Video::AppendFrame(const Image& image, int64_t timestamp_ns) {
+  if (empty()) {
+    height_ = static_cast<int>(image.rows());
+    width_ = static_cast<int>(image.cols());
+  }
+  // A size mismatch here is a programming error: readers validate sizes against the file.
+  if (image.rows() != height_ || image.cols() != width_) std::abort();
+  data_.insert(data_.end(), image.data(), image.data() + image.size());
+  timestamps_ns_.push_back(timestamp_ns);
+}
+
+int Video::NearestFrame(int64_t t_ns) const {
+  const auto upper = std::lower_bound(timestamps_ns_.begin(), timestamps_ns_.end(), t_ns);
+  if (upper == timestamps_ns_.begin()) return 0;
+  if (upper == timestamps_ns_.end()) return num_frames() - 1;
+  const int after = static_cast<int>(upper - timestamps_ns_.begin());
+  const int before = after - 1;
+  return (t_ns - timestamps_ns_[before] <= timestamps_ns_[after] - t_ns) ? before : after;
+}
+
+Image Video::InterpolateAt(int64_t t_ns) const {
+  const auto upper = std::upper_bound(timestamps_ns_.begin(), timestamps_ns_.end(), t_ns);
+  if (upper == timestamps_ns_.begin()) return frame(0);
+  if (upper == timestamps_ns_.end()) return frame(num_frames() - 1);
+  const int after = static_cast<int>(upper - timestamps_ns_.begin());
+  const int before = after - 1;
+  const double span = static_cast<double>(timestamps_ns_[after] - timestamps_ns_[before]);
+  const double weight_after = static_cast<double>(t_ns - timestamps_ns_[before]) / span;
+  return (1.0 - weight_after) * frame(before) + weight_after * frame(after);
+}
+
+}  // namespace evfs
