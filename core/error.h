@@ -4,6 +4,7 @@
 #ifndef EVFS_CORE_ERROR_H_
 #define EVFS_CORE_ERROR_H_
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 

@@ -4,6 +4,7 @@
 #ifndef EVFS_CORE_EVENT_FRAMES_H_
 #define EVFS_CORE_EVENT_FRAMES_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

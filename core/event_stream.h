@@ -2,6 +2,7 @@
 #ifndef EVFS_CORE_EVENT_STREAM_H_
 #define EVFS_CORE_EVENT_STREAM_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
