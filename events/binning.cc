@@ -1,0 +1,191 @@
+#include "events/binning.h"
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include "core/error.h"
+#include "events/option_checker.h"
+
+namespace evfs {
+namespace {
+
+/// Index range [first, last) of the events in [t_begin_ns, t_end_ns), after checking the window
+/// and those events (sorted, on the sensor, polarity ±1).
+struct WindowRange {
+  size_t first = 0;
+  size_t last = 0;
+};
+
+WindowRange CheckedWindow(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                          const char* caller) {
+  if (t_end_ns <= t_begin_ns) {
+    throw InvalidArgumentError(std::string(caller) + ": empty or reversed window [" +
+                               std::to_string(t_begin_ns) + ", " + std::to_string(t_end_ns) +
+                               ") ns");
+  }
+  WindowRange range;
+  range.first = events.LowerBound(t_begin_ns);
+  range.last = std::max(range.first, events.LowerBound(t_end_ns));
+  if (range.first == range.last) return range;
+  if (events.width() <= 0 || events.height() <= 0) {
+    throw InvalidArgumentError(std::string(caller) + ": the event stream has no sensor size");
+  }
+  const auto& t_ns = events.t_ns();
+  if (!std::is_sorted(t_ns.begin() + range.first, t_ns.begin() + range.last)) {
+    throw InvalidArgumentError(std::string(caller) + ": events are not sorted by time");
+  }
+  for (size_t i = range.first; i < range.last; ++i) {
+    if (events.x(i) >= events.width() || events.y(i) >= events.height() ||
+        (events.polarity(i) != 1 && events.polarity(i) != -1)) {
+      throw InvalidArgumentError(
+          std::string(caller) + ": event " + std::to_string(i) + " (x " +
+          std::to_string(events.x(i)) + ", y " + std::to_string(events.y(i)) + ", polarity " +
+          std::to_string(events.polarity(i)) + ") is off the " + std::to_string(events.width()) +
+          "x" + std::to_string(events.height()) + " sensor or has a polarity other than ±1");
+    }
+  }
+  return range;
+}
+
+/// ⌊value · numerator / denominator⌋ for value >= 0 without overflowing the product.
+int64_t FloorFraction(int64_t value, int64_t numerator, int64_t denominator) {
+  return (value / denominator) * numerator + (value % denominator) * numerator / denominator;
+}
+
+/// The midpoint of a <= b, rounded up, so that a < result <= b whenever a < b.
+int64_t MidpointRoundedUp(int64_t a, int64_t b) { return a + (b - a + 1) / 2; }
+
+/// Moves the inner entries of `times` (the first and last stay) by the fewest nanoseconds that
+/// make consecutive entries at least `min_gap_ns` apart: forward from the first, then backward
+/// from the last. Entries already far enough apart are unchanged.
+void MakeStrictlyIncreasing(std::vector<int64_t>* times, int64_t min_gap_ns, const char* caller) {
+  const size_t n = times->size();
+  if ((*times)[n - 1] - (*times)[0] < static_cast<int64_t>(n - 1) * min_gap_ns) {
+    throw InvalidArgumentError(std::string(caller) + ": a window of " +
+                               std::to_string((*times)[n - 1] - (*times)[0]) + " ns cannot hold " +
+                               std::to_string(n - 1) + " latent steps of " +
+                               std::to_string(min_gap_ns) + " ns or more");
+  }
+  for (size_t i = 1; i + 1 < n; ++i) {
+    (*times)[i] = std::max((*times)[i], (*times)[i - 1] + min_gap_ns);
+  }
+  for (size_t i = n - 1; i-- > 1;) {
+    (*times)[i] = std::min((*times)[i], (*times)[i + 1] - min_gap_ns);
+  }
+}
+
+int PixelIndex(const EventStream& events, size_t i) {
+  return static_cast<int>(events.y(i)) * events.width() + events.x(i);
+}
+
+}  // namespace
+
+EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns) {
+  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "BinByCollision");
+  EventFrames frames(events.height(), events.width());
+  std::vector<int64_t> latent_timestamps_ns = {t_begin_ns};
+
+  // last_fired[p] is the index of the last frame in which pixel p fired (-1: none yet). Frame
+  // indices only grow, so comparing with the current index replaces clearing every frame.
+  std::vector<int32_t> last_fired(static_cast<size_t>(frames.pixels_per_frame()), -1);
+  int32_t current = -1;
+  float* values = nullptr;
+  for (size_t i = range.first; i < range.last; ++i) {
+    const int64_t t_ns = events.t_ns(i);
+    const int pixel = PixelIndex(events, i);
+    if (current < 0 || last_fired[pixel] == current) {
+      if (current >= 0) {
+        latent_timestamps_ns.push_back(MidpointRoundedUp(frames.span(current).t_last_ns, t_ns));
+      }
+      EventFrameSpan span;
+      span.latent_first = current + 1;
+      span.latent_last = current + 2;
+      span.t_first_ns = t_ns;
+      span.t_last_ns = t_ns;
+      current = frames.AddFrame(span);
+      values = frames.frame_data(current);  // AddFrame may have moved the storage
+    }
+    last_fired[pixel] = current;
+    values[pixel] = static_cast<float>(events.polarity(i));
+    EventFrameSpan& span = frames.span(current);
+    span.t_last_ns = t_ns;
+    ++span.num_events;
+  }
+  latent_timestamps_ns.push_back(t_end_ns);
+  MakeStrictlyIncreasing(&latent_timestamps_ns, 1, "BinByCollision");
+  frames.set_latent_timestamps_ns(std::move(latent_timestamps_ns));
+  return frames;
+}
+
+bool StackedBinningOptions::IsValid(std::string* error) const {
+  OptionChecker check;
+  check.InRange("num_frames", num_frames, 1, std::numeric_limits<int>::max())
+      .InRange("steps_per_frame", steps_per_frame, 1, std::numeric_limits<int>::max())
+      .Require(split == Split::kEqualTime || split == Split::kEqualCount, "split",
+               "kEqualTime or kEqualCount");
+  return check.Passed(error);
+}
+
+EventFrames BinStacked(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                       const StackedBinningOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("BinStacked: " + error);
+  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "BinStacked");
+  const int num_frames = options.num_frames;
+  const int steps = options.steps_per_frame;
+  const int64_t duration_ns = t_end_ns - t_begin_ns;
+  const int64_t num_events = static_cast<int64_t>(range.last - range.first);
+
+  std::vector<int64_t> boundaries_ns(num_frames + 1);
+  boundaries_ns.front() = t_begin_ns;
+  boundaries_ns.back() = t_end_ns;
+  const bool equal_count =
+      options.split == StackedBinningOptions::Split::kEqualCount && num_events >= num_frames;
+  for (int m = 1; m < num_frames; ++m) {
+    if (equal_count) {
+      const size_t i = range.first + FloorFraction(num_events, m, num_frames);
+      boundaries_ns[m] = MidpointRoundedUp(events.t_ns(i - 1), events.t_ns(i));
+    } else {
+      boundaries_ns[m] = t_begin_ns + FloorFraction(duration_ns, m, num_frames);
+    }
+  }
+  MakeStrictlyIncreasing(&boundaries_ns, steps, "BinStacked");
+
+  std::vector<int64_t> latent_timestamps_ns;
+  latent_timestamps_ns.reserve(static_cast<size_t>(num_frames) * steps + 1);
+  for (int m = 0; m < num_frames; ++m) {
+    const int64_t frame_ns = boundaries_ns[m + 1] - boundaries_ns[m];
+    for (int s = 0; s < steps; ++s) {
+      latent_timestamps_ns.push_back(boundaries_ns[m] + FloorFraction(frame_ns, s, steps));
+    }
+  }
+  latent_timestamps_ns.push_back(t_end_ns);
+
+  EventFrames frames(events.height(), events.width());
+  const auto t_begin_it = events.t_ns().begin();
+  size_t frame_first = range.first;
+  for (int m = 0; m < num_frames; ++m) {
+    const size_t frame_last =
+        m + 1 == num_frames
+            ? range.last
+            : static_cast<size_t>(std::lower_bound(t_begin_it + frame_first,
+                                                   t_begin_it + range.last, boundaries_ns[m + 1]) -
+                                  t_begin_it);
+    EventFrameSpan span;
+    span.latent_first = m * steps;
+    span.latent_last = (m + 1) * steps;
+    span.num_events = static_cast<int64_t>(frame_last - frame_first);
+    span.t_first_ns = span.num_events > 0 ? events.t_ns(frame_first) : boundaries_ns[m];
+    span.t_last_ns = span.num_events > 0 ? events.t_ns(frame_last - 1) : boundaries_ns[m];
+    float* values = frames.frame_data(frames.AddFrame(span));
+    for (size_t i = frame_first; i < frame_last; ++i) {
+      values[PixelIndex(events, i)] += static_cast<float>(events.polarity(i));
+    }
+    frame_first = frame_last;
+  }
+  frames.set_latent_timestamps_ns(std::move(latent_timestamps_ns));
+  return frames;
+}
+
+}  // namespace evfs

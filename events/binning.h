@@ -1,0 +1,70 @@
+// Binning events into event frames and the latent timeline (paper §3.3, DESIGN.md §2).
+//
+// Both strategies take the events with t_begin_ns <= t < t_end_ns (a half-open window, like
+// EventStream::Slice) and return EventFrames whose latent timestamps start at t_begin_ns and end
+// at t_end_ns, strictly increasing.
+#ifndef EVFS_EVENTS_BINNING_H_
+#define EVFS_EVENTS_BINNING_H_
+
+#include <cstdint>
+#include <string>
+
+#include "core/event_frames.h"
+#include "core/event_stream.h"
+
+namespace evfs {
+
+/// The paper's Binning 1 (proposed): walk the events in time order; an event whose pixel already
+/// fired in the current frame closes that frame and opens a new one. Frames hold {-1, 0, +1}.
+///
+/// N collision frames give N latent steps: latent frames 0…N, event frame k spans latent k → k+1.
+/// τ_0 = t_begin_ns, τ_N = t_end_ns, and τ_k (0 < k < N) lies midway between the last event of
+/// frame k-1 and the first event of frame k (rounded up, so it is after the former). Where
+/// events share a timestamp two boundaries can coincide; each is then moved by the fewest
+/// nanoseconds that keep τ strictly increasing (forward first, then backward from t_end_ns), so
+/// it stays inside (τ_{k-1}, τ_{k+1}). With no events in the window there are no event frames
+/// and the latent timestamps are {t_begin_ns, t_end_ns} (K = 1).
+///
+/// O(number of events) time: a per-pixel index of the last frame that fired replaces clearing.
+///
+/// Throws InvalidArgumentError when t_end_ns <= t_begin_ns, when the events are not sorted or
+/// lie outside the sensor, or when the window has fewer nanoseconds than collision frames (only
+/// possible when one pixel fires repeatedly at the same timestamp).
+EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns);
+
+/// Options of the paper's Binning 2 (stacking).
+struct StackedBinningOptions {
+  /// How the window is split into frames.
+  enum class Split {
+    kEqualTime,   // frames of equal duration
+    kEqualCount,  // frames of (about) equal event count
+  };
+
+  int num_frames = 8;               // event frames M over the window, >= 1
+  Split split = Split::kEqualTime;  // how frame boundaries are placed
+  int steps_per_frame = 1;          // latent steps S each frame spans, >= 1
+
+  /// False (with a reason in `error`, which may be null) when a field is out of range.
+  bool IsValid(std::string* error) const;
+};
+
+/// The paper's Binning 2: `options.num_frames` frames over the window holding signed event
+/// counts. Frame m spans latent frames m·S … (m+1)·S, S = options.steps_per_frame, so there are
+/// M·S + 1 latent frames; within a frame the latent timestamps are uniform.
+///
+/// kEqualTime: frame boundaries (and so all latent timestamps) uniform over [t_begin, t_end].
+/// kEqualCount: boundary m (0 < m < M) lies midway between events ⌊n·m/M⌋-1 and ⌊n·m/M⌋ of the
+/// n events in the window (rounded up). Events are then assigned by time (boundary <= t), so
+/// events sharing a timestamp share a frame and counts are about n/M. With fewer events than
+/// frames (n < M) equal count is undefined and the split falls back to equal time. Boundaries
+/// that coincide are separated as in BinByCollision, by S ns at least.
+///
+/// Each span records its first and last event time and event count (an empty frame records its
+/// start boundary as both times). Throws InvalidArgumentError for invalid options, an empty or
+/// reversed window, a window shorter than M·S ns, unsorted events or events off the sensor.
+EventFrames BinStacked(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                       const StackedBinningOptions& options);
+
+}  // namespace evfs
+
+#endif  // EVFS_EVENTS_BINNING_H_

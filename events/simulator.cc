@@ -1,0 +1,178 @@
+#include "events/simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/time.h"
+#include "events/option_checker.h"
+
+namespace evfs {
+namespace {
+
+/// ESIM's floor on a drawn contrast threshold: a smaller one would fire on every flicker.
+constexpr double kMinContrastThreshold = 0.01;
+
+/// Marks a pixel that has not emitted an event since the last Reset.
+constexpr int64_t kNeverFired = std::numeric_limits<int64_t>::min();
+
+/// Offset between the seeds of the threshold and the noise generators (2^64 / golden ratio), so
+/// that the two streams of draws are unrelated.
+constexpr uint64_t kNoiseSeedOffset = 0x9E3779B97F4A7C15ull;
+
+/// Largest sensor side: event coordinates are uint16.
+constexpr int kMaxSensorSide = 65536;
+
+std::vector<double> DrawThresholds(double nominal, double sigma, size_t count, Random* random) {
+  std::vector<double> thresholds(count, std::max(kMinContrastThreshold, nominal));
+  if (sigma > 0.0) {
+    for (double& threshold : thresholds) {
+      threshold = std::max(kMinContrastThreshold, random->Normal(nominal, sigma));
+    }
+  }
+  return thresholds;
+}
+
+}  // namespace
+
+bool SimulatorOptions::IsValid(std::string* error) const {
+  OptionChecker check;
+  check.Positive("contrast_threshold_pos", contrast_threshold_pos)
+      .Positive("contrast_threshold_neg", contrast_threshold_neg)
+      .NonNegative("threshold_sigma", threshold_sigma)
+      .Require(refractory_period_ns >= 0, "refractory_period_ns", ">= 0")
+      .NonNegative("noise_rate_hz", noise_rate_hz)
+      .Positive("log_eps", log_eps);
+  return check.Passed(error);
+}
+
+EventSimulator::EventSimulator(int height, int width, const SimulatorOptions& options)
+    : height_(height),
+      width_(width),
+      options_(options),
+      noise_random_(options.seed + kNoiseSeedOffset) {
+  std::string error;
+  OptionChecker size_check;
+  size_check.InRange("height", height, 1, kMaxSensorSide)
+      .InRange("width", width, 1, kMaxSensorSide);
+  if (!options.IsValid(&error) || !size_check.Passed(&error)) {
+    throw InvalidArgumentError("EventSimulator: " + error);
+  }
+  const size_t num_pixels = static_cast<size_t>(height) * width;
+  Random threshold_random(options.seed);
+  threshold_pos_ = DrawThresholds(options.contrast_threshold_pos, options.threshold_sigma,
+                                  num_pixels, &threshold_random);
+  threshold_neg_ = DrawThresholds(options.contrast_threshold_neg, options.threshold_sigma,
+                                  num_pixels, &threshold_random);
+}
+
+void EventSimulator::CheckFrame(const Image& frame, const char* caller) const {
+  if (frame.rows() != height_ || frame.cols() != width_) {
+    throw InvalidArgumentError(std::string("EventSimulator::") + caller + ": frame of " +
+                               std::to_string(frame.cols()) + "x" + std::to_string(frame.rows()) +
+                               ", sensor is " + std::to_string(width_) + "x" +
+                               std::to_string(height_));
+  }
+  if (!frame.isFinite().all() || (frame < 0.0).any()) {
+    throw InvalidArgumentError(std::string("EventSimulator::") + caller +
+                               ": intensities must be finite and >= 0");
+  }
+}
+
+void EventSimulator::Reset(const Image& first_frame, int64_t t_ns) {
+  CheckFrame(first_frame, "Reset");
+  const size_t num_pixels = threshold_pos_.size();
+  log_intensity_.resize(num_pixels);
+  for (size_t p = 0; p < num_pixels; ++p) {
+    log_intensity_[p] = std::log(first_frame.data()[p] + options_.log_eps);
+  }
+  reference_ = log_intensity_;
+  last_event_ns_.assign(num_pixels, kNeverFired);
+  noise_random_ = Random(options_.seed + kNoiseSeedOffset);
+  t_ns_ = t_ns;
+  started_ = true;
+}
+
+void EventSimulator::AddSignalEvents(const Image& next_frame, int64_t t_ns,
+                                     std::vector<PendingEvent>* out) {
+  const double interval_ns = static_cast<double>(t_ns - t_ns_);
+  const int64_t num_pixels = static_cast<int64_t>(log_intensity_.size());
+  for (int64_t p = 0; p < num_pixels; ++p) {
+    const double log_before = log_intensity_[p];
+    const double log_after = std::log(next_frame.data()[p] + options_.log_eps);
+    log_intensity_[p] = log_after;
+    if (log_after == log_before) continue;
+    // L moves monotonically between the frames, and |L - reference| < C held at the previous
+    // frame, so only crossings in the direction of the change are possible.
+    const int8_t polarity = log_after > log_before ? 1 : -1;
+    const double threshold = polarity > 0 ? threshold_pos_[p] : threshold_neg_[p];
+    double& reference = reference_[p];
+    while (polarity * (log_after - reference) >= threshold) {
+      reference += polarity * threshold;
+      const double fraction =
+          std::clamp((reference - log_before) / (log_after - log_before), 0.0, 1.0);
+      const int64_t offset_ns = std::llround(fraction * interval_ns);
+      out->push_back({t_ns_ + std::clamp<int64_t>(offset_ns, 1, t_ns - t_ns_),
+                      static_cast<int32_t>(p), polarity});
+    }
+  }
+}
+
+void EventSimulator::AddNoiseEvents(int64_t t_ns, std::vector<PendingEvent>* out) {
+  if (options_.noise_rate_hz <= 0.0) return;
+  // Independent Poisson processes per pixel are one Poisson process over the sensor at the
+  // summed rate whose events land on uniformly drawn pixels.
+  const uint64_t num_pixels = log_intensity_.size();
+  const double rate_per_ns =
+      options_.noise_rate_hz * static_cast<double>(num_pixels) / kNanosecondsPerSecond;
+  const double interval_ns = static_cast<double>(t_ns - t_ns_);
+  for (double elapsed_ns = noise_random_.Exponential(rate_per_ns); elapsed_ns <= interval_ns;
+       elapsed_ns += noise_random_.Exponential(rate_per_ns)) {
+    const int64_t offset_ns = std::clamp<int64_t>(std::llround(elapsed_ns), 1, t_ns - t_ns_);
+    const int32_t pixel = static_cast<int32_t>(noise_random_.UniformIndex(num_pixels));
+    out->push_back({t_ns_ + offset_ns, pixel, noise_random_.Sign()});
+  }
+}
+
+EventStream EventSimulator::Advance(const Image& next_frame, int64_t t_ns) {
+  if (!started_) throw InvalidArgumentError("EventSimulator::Advance: called before Reset");
+  CheckFrame(next_frame, "Advance");
+  if (t_ns <= t_ns_) {
+    throw InvalidArgumentError("EventSimulator::Advance: frame time " + std::to_string(t_ns) +
+                               " ns is not after the previous frame's " + std::to_string(t_ns_) +
+                               " ns");
+  }
+  std::vector<PendingEvent> pending;
+  AddSignalEvents(next_frame, t_ns, &pending);
+  AddNoiseEvents(t_ns, &pending);
+  std::stable_sort(pending.begin(), pending.end(),
+                   [](const PendingEvent& a, const PendingEvent& b) {
+                     return a.t_ns != b.t_ns ? a.t_ns < b.t_ns : a.pixel < b.pixel;
+                   });
+
+  EventStream events(width_, height_);
+  events.reserve(pending.size());
+  for (const PendingEvent& event : pending) {
+    int64_t& last_ns = last_event_ns_[event.pixel];
+    if (last_ns != kNeverFired && event.t_ns - last_ns < options_.refractory_period_ns) continue;
+    last_ns = event.t_ns;
+    events.push_back(event.t_ns, static_cast<uint16_t>(event.pixel % width_),
+                     static_cast<uint16_t>(event.pixel / width_), event.polarity);
+  }
+  t_ns_ = t_ns;
+  return events;
+}
+
+EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options) {
+  if (frames.empty()) throw InvalidArgumentError("SimulateEvents: the video has no frames");
+  EventSimulator simulator(frames.height(), frames.width(), options);
+  simulator.Reset(frames.frame(0), frames.timestamp_ns(0));
+  EventStream events(frames.width(), frames.height());
+  for (int t = 1; t < frames.num_frames(); ++t) {
+    events.Append(simulator.Advance(frames.frame(t), frames.timestamp_ns(t)));
+  }
+  return events;
+}
+
+}  // namespace evfs

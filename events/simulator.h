@@ -1,0 +1,102 @@
+// An event-camera simulator in the manner of ESIM: H. Rebecq, D. Gehrig, D. Scaramuzza, "ESIM:
+// an Open Event Camera Simulator", CoRL 2018.
+//
+// Each pixel tracks L = log(I + log_eps). Between two frames L is interpolated linearly in time;
+// whenever L - reference reaches +C_pos (or -C_neg) the pixel emits an ON (OFF) event at the
+// interpolated crossing time and its reference moves by exactly ±C, so one frame pair may give
+// several events per pixel. Thus, without noise or refractory period, after every frame
+//   -C_neg < L(last frame) - (L(first frame) + C_pos · #ON - C_neg · #OFF) < C_pos
+// at every pixel (the round trip ESIM is tested by).
+#ifndef EVFS_EVENTS_SIMULATOR_H_
+#define EVFS_EVENTS_SIMULATOR_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/event_stream.h"
+#include "core/video.h"
+#include "events/random.h"
+
+namespace evfs {
+
+/// Sensor model of the simulator. The defaults describe a clean DAVIS-like sensor: contrast
+/// thresholds of 0.2 in log intensity (DAVIS346/240 are typically set to 0.1–0.5), a 0.03
+/// per-pixel threshold mismatch (the few-percent fixed-pattern spread measured on DVS pixels),
+/// and neither refractory period nor background noise, so that benchmarks see realistic but
+/// clean events. Benchmarks depend on these values: change them only with the benchmarks.
+struct SimulatorOptions {
+  double contrast_threshold_pos = 0.2;  // nominal ON threshold C_pos, in log intensity, > 0
+  double contrast_threshold_neg = 0.2;  // nominal OFF threshold C_neg, in log intensity, > 0
+  double threshold_sigma = 0.03;        // std dev of the per-pixel thresholds around C, >= 0
+  int64_t refractory_period_ns = 0;     // events closer than this to the pixel's last are dropped
+  double noise_rate_hz = 0.0;           // background events per pixel per second (random sign)
+  double log_eps = 1e-3;                // offset b of L = log(I + b), > 0
+  uint64_t seed = 42;                   // seeds the thresholds and the noise
+
+  /// False (with a reason in `error`, which may be null) when a field is out of range.
+  bool IsValid(std::string* error) const;
+};
+
+/// Turns a sequence of frames (linear intensity, nominally [0, 1], never negative) into events.
+///
+/// Per-pixel thresholds are drawn once, in the constructor, from N(C, threshold_sigma) and
+/// clamped to >= 0.01 (ESIM's floor). ESIM redraws them for every frame pair; a fixed draw is the
+/// fixed-pattern mismatch of a real sensor.
+///
+/// Refractory period: as in ESIM, an event closer than refractory_period_ns to the last event
+/// the pixel emitted is dropped but the pixel's reference level still moves, so the reference
+/// keeps following the signal (and the round trip holds for emitted plus dropped events, not
+/// for the emitted ones alone). Noise events obey the same refractory rule and never move the
+/// reference.
+class EventSimulator {
+ public:
+  /// Throws InvalidArgumentError for invalid options or a size outside [1, 65536].
+  EventSimulator(int height, int width, const SimulatorOptions& options);
+
+  /// Starts (or restarts) the sensor at `first_frame`: every reference level is set to the
+  /// frame's log intensity, the refractory memory is cleared and the noise generator reseeded,
+  /// so the events after a Reset depend only on the options and the frames given since.
+  void Reset(const Image& first_frame, int64_t t_ns);
+
+  /// The events between the previous frame and `next_frame`, with timestamps in
+  /// (previous t_ns, t_ns], sorted by time (ties by pixel index, then in order of generation),
+  /// sensor size set. Throws InvalidArgumentError before Reset, for a frame of another size,
+  /// a negative or non-finite intensity, or t_ns not after the previous frame.
+  EventStream Advance(const Image& next_frame, int64_t t_ns);
+
+  int height() const { return height_; }
+  int width() const { return width_; }
+
+ private:
+  /// One event before sorting and the refractory filter.
+  struct PendingEvent {
+    int64_t t_ns;
+    int32_t pixel;
+    int8_t polarity;
+  };
+
+  void CheckFrame(const Image& frame, const char* caller) const;
+  void AddSignalEvents(const Image& next_frame, int64_t t_ns, std::vector<PendingEvent>* out);
+  void AddNoiseEvents(int64_t t_ns, std::vector<PendingEvent>* out);
+
+  int height_;
+  int width_;
+  SimulatorOptions options_;
+  std::vector<double> threshold_pos_;   // per-pixel C_pos
+  std::vector<double> threshold_neg_;   // per-pixel C_neg
+  std::vector<double> log_intensity_;   // L at the previous frame
+  std::vector<double> reference_;       // the level the next crossing is measured from
+  std::vector<int64_t> last_event_ns_;  // last emitted event per pixel (refractory)
+  Random noise_random_;
+  int64_t t_ns_ = 0;      // time of the previous frame
+  bool started_ = false;  // Reset has been called
+};
+
+/// Simulates the events of a whole video (frame 0 starts the sensor); the stream's sensor size
+/// is the video's. Throws InvalidArgumentError for an empty video or as EventSimulator does.
+EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options);
+
+}  // namespace evfs
+
+#endif  // EVFS_EVENTS_SIMULATOR_H_
