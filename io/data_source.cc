@@ -1,0 +1,58 @@
+#include "io/data_source.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <utility>
+
+#include "core/error.h"
+#include "io/hdf5_io.h"
+#include "io/text_folder.h"
+
+namespace evfs {
+
+bool FrameInfo::operator==(const FrameInfo& other) const {
+  return t_ns == other.t_ns && path == other.path && has_exposure == other.has_exposure &&
+         exposure_begin_ns == other.exposure_begin_ns && exposure_end_ns == other.exposure_end_ns;
+}
+
+DataSource::DataSource(std::string path, int width, int height, std::vector<FrameInfo> frames)
+    : path_(std::move(path)), width_(width), height_(height), frames_(std::move(frames)) {}
+
+DataSource::~DataSource() = default;
+
+bool IsHdf5Path(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".h5" || extension == ".hdf5";
+}
+
+std::unique_ptr<DataSource> DataSource::Open(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    return std::make_unique<TextFolderDataSource>(path);
+  }
+  if (IsHdf5Path(path)) return std::make_unique<Hdf5DataSource>(path);
+  if (!std::filesystem::exists(path, error)) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0, "no such data folder or HDF5 file");
+  }
+  throw InputError(InputError::Kind::kMalformed, path, 0,
+                   "expected a data folder or an .h5/.hdf5 file");
+}
+
+void ConvertRecording(const std::string& input, const std::string& output) {
+  const std::unique_ptr<DataSource> source = DataSource::Open(input);
+  const EventStream events = source->ReadAllEvents();
+  std::vector<Image> images;
+  for (int i = 0; i < static_cast<int>(source->frames().size()); ++i) {
+    images.push_back(source->ReadImage(i));
+  }
+  if (IsHdf5Path(output)) {
+    WriteHdf5(output, events, source->frames(), images);
+  } else {
+    WriteDataFolder(output, events, source->frames(), images);
+  }
+}
+
+}  // namespace evfs

@@ -1,0 +1,40 @@
+// Grey frames on disk: PNG in and out, and the timestamps file that goes with a frame sequence.
+#ifndef EVFS_IO_IMAGE_IO_H_
+#define EVFS_IO_IMAGE_IO_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/video.h"
+
+namespace evfs {
+
+/// Reads an 8- or 16-bit image (colour is converted to grey) scaled to [0, 1]: 8-bit values are
+/// divided by 255, 16-bit ones by 65535. Throws InputError(kMissingFile) when the file is
+/// missing or cannot be decoded.
+Image ReadGreyImage(const std::string& path);
+
+/// The fewest bits per pixel (8 or 16) that hold `image` exactly as ReadGreyImage returns it:
+/// 8 when every value is k / 255 for an integer k in [0, 255], else 16.
+int MinimalBitDepth(const Image& image);
+
+/// Writes a 16-bit grey PNG: values clamped to [0, 1], scaled by 65535 and rounded.
+/// Throws InputError(kUnwritable).
+void WriteGreyPng16(const std::string& path, const Image& image);
+
+/// Writes an 8-bit grey PNG: values clamped to [0, 1], scaled by 255 and rounded.
+/// Throws InputError(kUnwritable).
+void WriteGreyPng8(const std::string& path, const Image& image);
+
+/// Writes an 8-bit PNG when MinimalBitDepth(image) is 8, else a 16-bit one, so that reading
+/// it back gives `image` unchanged whenever it came from an 8- or 16-bit file.
+void WriteGreyPngLossless(const std::string& path, const Image& image);
+
+/// Writes `index t_seconds` lines (0-based index, 9 decimals, exact) for a frame sequence.
+/// Throws InputError(kUnwritable).
+void WriteTimestampsTxt(const std::string& path, const std::vector<int64_t>& t_ns);
+
+}  // namespace evfs
+
+#endif  // EVFS_IO_IMAGE_IO_H_

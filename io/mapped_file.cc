@@ -1,0 +1,74 @@
+#include "io/mapped_file.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <utility>
+
+#include "core/error.h"
+
+namespace evfs {
+namespace {
+
+[[noreturn]] void ThrowCannotOpen(const std::string& path, const std::string& why) {
+  throw InputError(InputError::Kind::kMissingFile, path, 0, "cannot read the file: " + why);
+}
+
+// Closes a file descriptor on every path out of the constructor.
+class FileDescriptor {
+ public:
+  explicit FileDescriptor(int fd) : fd_(fd) {}
+  ~FileDescriptor() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+  int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+}  // namespace
+
+MappedFile::MappedFile(const std::string& path) : path_(path) {
+  const FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+  if (fd.get() < 0) ThrowCannotOpen(path, std::strerror(errno));
+  struct stat info;
+  if (::fstat(fd.get(), &info) != 0) ThrowCannotOpen(path, std::strerror(errno));
+  if (!S_ISREG(info.st_mode)) ThrowCannotOpen(path, "not a regular file");
+  size_ = static_cast<size_t>(info.st_size);
+  if (size_ == 0) return;  // mmap rejects a zero length; an empty buffer needs no mapping
+  void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd.get(), 0);
+  if (mapped == MAP_FAILED) ThrowCannotOpen(path, std::strerror(errno));
+  data_ = static_cast<const char*>(mapped);
+}
+
+MappedFile::~MappedFile() { Unmap(); }
+
+MappedFile::MappedFile(MappedFile&& other) noexcept
+    : path_(std::move(other.path_)),
+      data_(std::exchange(other.data_, nullptr)),
+      size_(std::exchange(other.size_, 0)) {}
+
+MappedFile& MappedFile::operator=(MappedFile&& other) noexcept {
+  if (this != &other) {
+    Unmap();
+    path_ = std::move(other.path_);
+    data_ = std::exchange(other.data_, nullptr);
+    size_ = std::exchange(other.size_, 0);
+  }
+  return *this;
+}
+
+void MappedFile::Unmap() {
+  if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
+  data_ = nullptr;
+  size_ = 0;
+}
+
+}  // namespace evfs

@@ -1,0 +1,135 @@
+#include "io/text_folder.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <utility>
+
+#include "core/error.h"
+#include "io/frame_list.h"
+#include "io/image_io.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kEventsFile[] = "events.txt";
+constexpr char kImagesFile[] = "images.txt";
+constexpr char kExposuresFile[] = "exposures.txt";
+
+bool IsFile(const fs::path& path) {
+  std::error_code error;
+  return fs::is_regular_file(path, error);
+}
+
+std::vector<FrameInfo> ReadFolderFrames(const std::string& folder) {
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) {
+    throw InputError(InputError::Kind::kMissingFile, folder, 0, "data folder does not exist");
+  }
+  const fs::path images_txt = fs::path(folder) / kImagesFile;
+  if (!IsFile(images_txt)) return {};
+  std::vector<FrameInfo> frames = ReadFrameList(images_txt.string());
+  const fs::path exposures_txt = fs::path(folder) / kExposuresFile;
+  if (IsFile(exposures_txt)) ReadExposures(exposures_txt.string(), &frames);
+  return frames;
+}
+
+// A path that stays inside the folder and names a PNG can be written as given.
+bool IsWritableFramePath(const std::string& path) {
+  const fs::path relative(path);
+  if (relative.empty() || relative.is_absolute() || relative.extension() != ".png") return false;
+  for (const fs::path& part : relative) {
+    if (part == "..") return false;
+  }
+  return true;
+}
+
+std::string DefaultFramePath(size_t index) {
+  char name[48];
+  std::snprintf(name, sizeof(name), "images/frame_%08zu.png", index);
+  return name;
+}
+
+}  // namespace
+
+TextFolderDataSource::TextFolderDataSource(const std::string& folder)
+    : TextFolderDataSource(folder, ReadFolderFrames(folder)) {}
+
+TextFolderDataSource::TextFolderDataSource(const std::string& folder, std::vector<FrameInfo> frames)
+    : DataSource(folder, 0, 0, std::move(frames)) {
+  const std::string events_txt = (fs::path(folder) / kEventsFile).string();
+  if (!IsFile(events_txt)) {
+    throw InputError(InputError::Kind::kMissingFile, events_txt, 0, "events file does not exist");
+  }
+  if (!frames_.empty()) {
+    const Image first = ReadGreyImage((fs::path(folder) / frames_.front().path).string());
+    width_ = static_cast<int>(first.cols());
+    height_ = static_cast<int>(first.rows());
+  } else {
+    const EventSummary summary = EventTextReader(events_txt).Summarize();
+    width_ = summary.max_x + 1;
+    height_ = summary.max_y + 1;
+  }
+  events_ = std::make_unique<EventTextReader>(events_txt, width_, height_);
+}
+
+TextFolderDataSource::~TextFolderDataSource() = default;
+
+Image TextFolderDataSource::ReadImage(int index) const {
+  if (index < 0 || index >= static_cast<int>(frames_.size())) {
+    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
+                               std::to_string(frames_.size()) + ")");
+  }
+  const std::string image_path = (fs::path(path_) / frames_[index].path).string();
+  Image image = ReadGreyImage(image_path);
+  if (image.cols() != width_ || image.rows() != height_) {
+    throw InputError(InputError::Kind::kSizeMismatch, image_path, 0,
+                     "image is " + std::to_string(image.cols()) + "x" +
+                         std::to_string(image.rows()) + ", expected the sensor size " +
+                         std::to_string(width_) + "x" + std::to_string(height_) +
+                         " of the first image");
+  }
+  return image;
+}
+
+EventStream TextFolderDataSource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
+  return events_->Read(t_begin_ns, t_end_ns);
+}
+
+EventStream TextFolderDataSource::ReadAllEvents() const { return events_->ReadAll(); }
+
+EventSummary TextFolderDataSource::Summarize() const { return events_->Summarize(); }
+
+void WriteDataFolder(const std::string& folder, const EventStream& events,
+                     const std::vector<FrameInfo>& frames, const std::vector<Image>& images) {
+  if (frames.size() != images.size()) {
+    throw InvalidArgumentError("WriteDataFolder: " + std::to_string(frames.size()) +
+                               " frames but " + std::to_string(images.size()) + " images");
+  }
+  std::error_code error;
+  fs::create_directories(folder, error);
+  if (error) {
+    throw InputError(InputError::Kind::kUnwritable, folder, 0,
+                     "cannot create the folder: " + error.message());
+  }
+  WriteEventsText((fs::path(folder) / kEventsFile).string(), events);
+
+  std::vector<FrameInfo> written = frames;
+  bool any_exposure = false;
+  for (size_t i = 0; i < written.size(); ++i) {
+    if (!IsWritableFramePath(written[i].path)) written[i].path = DefaultFramePath(i);
+    const fs::path image_path = fs::path(folder) / written[i].path;
+    fs::create_directories(image_path.parent_path(), error);
+    if (error) {
+      throw InputError(InputError::Kind::kUnwritable, image_path.parent_path().string(), 0,
+                       "cannot create the folder: " + error.message());
+    }
+    WriteGreyPngLossless(image_path.string(), images[i]);
+    any_exposure = any_exposure || written[i].has_exposure;
+  }
+  if (!frames.empty()) WriteFrameList((fs::path(folder) / kImagesFile).string(), written);
+  if (any_exposure) WriteExposures((fs::path(folder) / kExposuresFile).string(), written);
+}
+
+}  // namespace evfs

@@ -1,0 +1,262 @@
+#include "io/hdf5_io.h"
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tests/io/io_test_util.h"
+#include "tests/test_data.h"
+
+namespace evfs {
+namespace {
+
+constexpr int kWidth = 64;
+constexpr int kHeight = 48;
+
+struct Recording {
+  EventStream events;
+  std::vector<FrameInfo> frames;
+  std::vector<Image> images;
+};
+
+// Events with nanosecond timestamps, an 8-bit and a 16-bit frame, one with an exposure.
+Recording MakeRecording(uint32_t seed, int num_events) {
+  Recording recording;
+  recording.events = testing::MakeRandomEvents(seed, num_events, kWidth, kHeight, 2713584001, 9999);
+  recording.frames.resize(2);
+  recording.frames[0].t_ns = 2713576000;
+  recording.frames[0].path = "images/frame_00000000.png";
+  recording.frames[0].has_exposure = true;
+  recording.frames[0].exposure_begin_ns = 2700000001;
+  recording.frames[0].exposure_end_ns = 2727152000;
+  recording.frames[1].t_ns = 2752341000;
+  recording.frames[1].path = "images/frame_00000001.png";
+  recording.images = {testing::MakeRandomImage(seed + 1, kWidth, kHeight, 8),
+                      testing::MakeRandomImage(seed + 2, kWidth, kHeight, 16)};
+  return recording;
+}
+
+// The HDF5 type class and size of dataset `name`, to check what the writer chose.
+std::pair<H5T_class_t, size_t> DatasetType(const std::string& path, const std::string& name) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t dataset = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
+  const hid_t type = H5Dget_type(dataset);
+  const std::pair<H5T_class_t, size_t> result(H5Tget_class(type), H5Tget_size(type));
+  H5Tclose(type);
+  H5Dclose(dataset);
+  H5Fclose(file);
+  return result;
+}
+
+// Writes /events/{ts,xs,ys,ps} with the given file types, the way other tools do.
+template <typename T, typename P>
+void WriteRawEvents(const std::string& path, const std::vector<T>& ts, hid_t ts_type,
+                    const std::vector<uint16_t>& xs, const std::vector<uint16_t>& ys,
+                    const std::vector<P>& ps, hid_t ps_type, const char* ts_unit) {
+  const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t group = H5Gcreate2(file, "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const hsize_t n = ts.size();
+  const hid_t space = H5Screate_simple(1, &n, nullptr);
+  const auto write = [&](const char* name, hid_t type, const void* data) {
+    const hid_t dataset =
+        H5Dcreate2(group, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(dataset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    if (ts_unit != nullptr && std::string(name) == "ts") {
+      const hid_t string_type = H5Tcopy(H5T_C_S1);
+      H5Tset_size(string_type, H5T_VARIABLE);
+      const hid_t scalar = H5Screate(H5S_SCALAR);
+      const hid_t attribute =
+          H5Acreate2(dataset, "ts_unit", string_type, scalar, H5P_DEFAULT, H5P_DEFAULT);
+      H5Awrite(attribute, string_type, &ts_unit);
+      H5Aclose(attribute);
+      H5Sclose(scalar);
+      H5Tclose(string_type);
+    }
+    H5Dclose(dataset);
+  };
+  write("ts", ts_type, ts.data());
+  write("xs", H5T_NATIVE_UINT16, xs.data());
+  write("ys", H5T_NATIVE_UINT16, ys.data());
+  write("ps", ps_type, ps.data());
+  H5Sclose(space);
+  H5Gclose(group);
+  H5Fclose(file);
+}
+
+TEST(Hdf5IoTest, RoundTripIsLossless) {
+  const Recording recording = MakeRecording(1, 5000);
+  const std::string path = testing::ScratchDir("h5_roundtrip") + "/recording.h5";
+  WriteHdf5(path, recording.events, recording.frames, recording.images);
+
+  const Hdf5DataSource source(path);
+  EXPECT_EQ(source.width(), kWidth);
+  EXPECT_EQ(source.height(), kHeight);
+  EXPECT_EQ(source.num_events(), 5000);
+  EXPECT_EQ(source.ReadAllEvents(), recording.events);
+  EXPECT_EQ(source.frames(), recording.frames);
+  for (int i = 0; i < 2; ++i) EXPECT_TRUE((source.ReadImage(i) == recording.images[i]).all()) << i;
+  EXPECT_EQ(DatasetType(path, "images/image000000000"), std::make_pair(H5T_INTEGER, size_t{1}));
+  EXPECT_EQ(DatasetType(path, "images/image000000001"), std::make_pair(H5T_INTEGER, size_t{2}));
+  EXPECT_EQ(DatasetType(path, "events/ts"), std::make_pair(H5T_FLOAT, size_t{8}));
+}
+
+TEST(Hdf5IoTest, WindowedReadEqualsSlicingTheFullRead) {
+  const EventStream events =
+      testing::MakeRandomEvents(8, 200000, kWidth, kHeight, 1000000000, 20000);
+  const std::string path = testing::ScratchDir("h5_window") + "/events.h5";
+  WriteHdf5(path, events, {}, {});
+  const Hdf5DataSource source(path);
+  const EventStream all = source.ReadAllEvents();
+  ASSERT_EQ(all, events);
+  const int64_t first = all.first_t_ns();
+  const int64_t last = all.last_t_ns();
+  const std::vector<std::pair<int64_t, int64_t>> windows = {
+      {first, last + 1},          {0, first},
+      {last, last + 1},           {last + 1, last + 100},
+      {all.t_ns(5), all.t_ns(5)}, {all.t_ns(1000) + 1, all.t_ns(123456)},
+  };
+  for (const auto& window : windows) {
+    EXPECT_EQ(source.ReadEvents(window.first, window.second),
+              all.Slice(window.first, window.second));
+  }
+  EXPECT_EQ(source.LowerBound(all.t_ns(777)), static_cast<int64_t>(all.LowerBound(all.t_ns(777))));
+  const EventSummary summary = source.Summarize();
+  EXPECT_EQ(summary.count, 200000);
+  EXPECT_EQ(summary.positive, static_cast<int64_t>(events.CountPositive()));
+  EXPECT_EQ(summary.t_first_ns, first);
+  EXPECT_EQ(summary.t_last_ns, last);
+}
+
+TEST(Hdf5IoTest, WindowedReadKeepsWholeRunsOfEqualTimestamps) {
+  const std::string path = testing::ScratchDir("h5_runs") + "/events.h5";
+  testing::ExpectWindowsKeepWholeRuns(
+      kWidth, kHeight, [&](const EventStream& events) { WriteHdf5(path, events, {}, {}); },
+      [&](int64_t t_begin_ns, int64_t t_end_ns) {
+        return Hdf5DataSource(path).ReadEvents(t_begin_ns, t_end_ns);
+      });
+}
+
+TEST(Hdf5IoTest, TimesBeyondExactDoublesAreStoredAsIntegerNanoseconds) {
+  EventStream events(kWidth, kHeight);
+  events.push_back(4000000000000000001, 1, 2, 1);  // ~127 years: float64 seconds would round
+  events.push_back(4000000000000000002, 3, 4, -1);
+  const std::string path = testing::ScratchDir("h5_int_ns") + "/events.h5";
+  WriteHdf5(path, events, {}, {});
+  EXPECT_EQ(DatasetType(path, "events/ts").first, H5T_INTEGER);
+  EXPECT_EQ(Hdf5DataSource(path).ReadAllEvents(), events);
+}
+
+TEST(Hdf5IoTest, ReadsFilesOfOtherTools) {
+  const std::string dir = testing::ScratchDir("h5_other_tools");
+  const std::vector<uint16_t> xs = {1, 5, 9};
+  const std::vector<uint16_t> ys = {2, 6, 7};
+  const std::vector<int8_t> minus_one_one = {-1, 1, -1};
+  // Integer microseconds (no unit attribute), nanoseconds with ts_unit, and float seconds with
+  // h5py-style bool polarity.
+  WriteRawEvents(dir + "/us.h5", std::vector<int64_t>{10, 20, 20}, H5T_NATIVE_INT64, xs, ys,
+                 minus_one_one, H5T_NATIVE_INT8, nullptr);
+  WriteRawEvents(dir + "/ns.h5", std::vector<int64_t>{10, 20, 20}, H5T_NATIVE_INT64, xs, ys,
+                 std::vector<uint8_t>{0, 1, 0}, H5T_NATIVE_UINT8, "ns");
+  const hid_t bool_type = H5Tenum_create(H5T_NATIVE_INT8);
+  const int8_t false_value = 0;
+  const int8_t true_value = 1;
+  H5Tenum_insert(bool_type, "FALSE", &false_value);
+  H5Tenum_insert(bool_type, "TRUE", &true_value);
+  WriteRawEvents(dir + "/bool.h5", std::vector<double>{0.5, 0.75, 1.000000001}, H5T_NATIVE_DOUBLE,
+                 xs, ys, std::vector<int8_t>{0, 1, 0}, bool_type, nullptr);
+  H5Tclose(bool_type);
+
+  const auto expected = [&](std::vector<int64_t> t_ns) {
+    EventStream events(10, 8);  // no sensor_resolution, no frames: largest coordinate + 1
+    for (int i = 0; i < 3; ++i) events.push_back(t_ns[i], xs[i], ys[i], i == 1 ? 1 : -1);
+    return events;
+  };
+  EXPECT_EQ(Hdf5DataSource(dir + "/us.h5").ReadAllEvents(), expected({10000, 20000, 20000}));
+  EXPECT_EQ(Hdf5DataSource(dir + "/ns.h5").ReadAllEvents(), expected({10, 20, 20}));
+  EXPECT_EQ(Hdf5DataSource(dir + "/bool.h5").ReadAllEvents(),
+            expected({500000000, 750000000, 1000000001}));
+}
+
+TEST(Hdf5IoTest, InvalidEventsAreInputErrors) {
+  const std::string dir = testing::ScratchDir("h5_invalid_events");
+  const std::vector<uint16_t> xs = {1, 5, 9};
+  const std::vector<uint16_t> ys = {2, 6, 7};
+  WriteRawEvents(dir + "/polarity.h5", std::vector<double>{0.1, 0.2, 0.3}, H5T_NATIVE_DOUBLE, xs,
+                 ys, std::vector<int8_t>{0, 2, 1}, H5T_NATIVE_INT8, nullptr);
+  WriteRawEvents(dir + "/backwards.h5", std::vector<double>{0.1, 0.3, 0.2}, H5T_NATIVE_DOUBLE, xs,
+                 ys, std::vector<int8_t>{0, 1, 1}, H5T_NATIVE_INT8, nullptr);
+  WriteRawEvents(dir + "/unit.h5", std::vector<int64_t>{1, 2, 3}, H5T_NATIVE_INT64, xs, ys,
+                 std::vector<int8_t>{0, 1, 1}, H5T_NATIVE_INT8, "fortnights");
+  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/polarity.h5"); },
+                            InputError::Kind::kOutOfRange, "events/ps[1]", 0);
+  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/backwards.h5"); },
+                            InputError::Kind::kNotMonotonic, "events/ts[2]", 0);
+  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/unit.h5"); },
+                            InputError::Kind::kMalformed, "ts_unit", 0);
+
+  // Coordinates outside sensor_resolution.
+  EventStream events(kWidth, kHeight);
+  events.push_back(1000, kWidth - 1, 0, 1);
+  events.push_back(2000, kWidth, 0, 1);
+  WriteHdf5(dir + "/outside.h5", events, {}, {});
+  const Hdf5DataSource source(dir + "/outside.h5");
+  testing::ExpectInputError([&] { source.ReadAllEvents(); }, InputError::Kind::kOutOfRange,
+                            "events/xs[1]", 0);
+  EXPECT_EQ(source.ReadEvents(0, 1500).size(), 1u);
+}
+
+TEST(Hdf5IoTest, CorruptOrIncompleteFilesAreInputErrors) {
+  const std::string dir = testing::ScratchDir("h5_corrupt");
+  const Recording recording = MakeRecording(2, 100000);
+  const std::string good = dir + "/good.h5";
+  WriteHdf5(good, recording.events, recording.frames, recording.images);
+
+  const std::string truncated = dir + "/truncated.h5";
+  std::filesystem::copy_file(good, truncated);
+  std::filesystem::resize_file(truncated, std::filesystem::file_size(good) / 2);
+  testing::ExpectInputError([&] { Hdf5DataSource source(truncated); }, InputError::Kind::kMalformed,
+                            truncated, 0);
+
+  const std::string garbage = dir + "/garbage.h5";
+  testing::WriteFile(garbage, std::string(4096, 'x'));
+  testing::ExpectInputError([&] { Hdf5DataSource source(garbage); }, InputError::Kind::kMalformed,
+                            garbage, 0);
+
+  const std::string missing_dataset = dir + "/missing_dataset.h5";
+  std::filesystem::copy_file(good, missing_dataset);
+  const hid_t file = H5Fopen(missing_dataset.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  ASSERT_GE(H5Ldelete(file, "events/ps", H5P_DEFAULT), 0);
+  H5Fclose(file);
+  const InputError error =
+      testing::CatchInputError([&] { Hdf5DataSource source(missing_dataset); });
+  EXPECT_EQ(error.kind(), InputError::Kind::kMalformed);
+  EXPECT_NE(std::string(error.what()).find("events/ps"), std::string::npos) << error.what();
+
+  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/nope.h5"); },
+                            InputError::Kind::kMissingFile, dir + "/nope.h5", 0);
+}
+
+TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {
+  Recording recording = MakeRecording(3, 10);
+  recording.images[1] = testing::MakeRandomImage(4, kWidth + 1, kHeight, 8);
+  const std::string path = testing::ScratchDir("h5_size") + "/recording.h5";
+  WriteHdf5(path, recording.events, recording.frames, recording.images);
+  const Hdf5DataSource source(path);
+  EXPECT_NO_THROW(source.ReadImage(0));
+  testing::ExpectInputError([&] { source.ReadImage(1); }, InputError::Kind::kSizeMismatch,
+                            "images/image000000001", 0);
+}
+
+TEST(Hdf5IoTest, UnwritablePathIsAnInputError) {
+  const std::string path = testing::ScratchDir("h5_unwritable") + "/no/folder/out.h5";
+  testing::ExpectInputError([&] { WriteHdf5(path, EventStream(), {}, {}); },
+                            InputError::Kind::kUnwritable, path, 0);
+  EXPECT_THROW(WriteHdf5(path, EventStream(), std::vector<FrameInfo>(1), {}), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace evfs
