@@ -1,0 +1,340 @@
+// evfs — event-driven video frame synthesis from the command line (DESIGN.md §8).
+//
+//   evfs info        --data=DIR [--first=I --last=J]
+//   evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]
+//                    [--truth=K] --out=OUT [solver and model flags]
+//   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
+//   evfs convert     --data=DIR|FILE.h5 --out=FILE.h5|DIR
+//   evfs demo        --out=DIR
+//
+// Flags are read here and nowhere else; every failure that is the user's (a bad file, a bad
+// flag) prints one line and exits with status 2.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include "core/error.h"
+#include "core/time.h"
+#include "events/binning.h"
+#include "events/simulator.h"
+#include "examples/demo.h"
+#include "examples/reconstruct_job.h"
+#include "io/data_source.h"
+#include "io/frame_list.h"
+#include "io/image_io.h"
+#include "io/text_folder.h"
+
+// Input and output.
+DEFINE_string(data, "", "Data folder (Event Camera Dataset layout) or HDF5 event file.");
+DEFINE_string(frames, "", "simulate: folder with images.txt ('t path' lines) and the frames.");
+DEFINE_string(out, "", "Output folder (reconstruct, simulate, demo) or file (convert to .h5).");
+// Which frames.
+DEFINE_int32(first, -1, "0-based images.txt line of the first (or blurred) frame.");
+DEFINE_int32(last, -1,
+             "interpolate: the last frame; predict: the frame whose time ends the window "
+             "(default first + 1); info: with --first, the window to describe.");
+DEFINE_int32(truth, -1, "Frame to score the reconstruction against (PSNR, SSIM); -1: none.");
+DEFINE_string(mode, "", "interpolate | predict | deblur.");
+DEFINE_double(exposure_s, 0.0, "deblur: exposure around the frame's timestamp, when the data "
+              "has no exposures.txt.");
+DEFINE_double(fps, 0.0, "Resample the latent video to this uniform frame rate; 0 writes the "
+              "latent frames themselves.");
+// Binning.
+DEFINE_string(binning, "auto", "auto | collision | stacked. auto: collision binning (the "
+              "paper's), unless it gives more than --max_latent_frames frames.");
+DEFINE_int32(max_latent_frames, evfs::BinningOptions().max_latent_frames, "auto binning: most latent steps before switching to "
+             "stacked equal-time binning with this many frames.");
+DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
+             "auto binning: most pixels x latent frames (at least 4 steps are kept); bounds "
+             "memory on large sensors (Ceres needs ~1 GB per million).");
+DEFINE_int32(stacked_frames, evfs::BinningOptions().stacked.num_frames, "stacked binning: number of event frames.");
+// Objective.
+DEFINE_double(frame_weight, evfs::ObjectiveOptions().frame_weight, "Weight of the frame term.");
+DEFINE_double(event_weight, evfs::ObjectiveOptions().event_weight, "lambda_e: weight of the event term.");
+DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight, "lambda_xy: weight of spatial total variation.");
+DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight, "lambda_t: weight of temporal total variation.");
+DEFINE_double(alpha, 0.0, "alpha of tanh(alpha * dg); 0 derives it from the data's contrast "
+              "threshold (printed).");
+DEFINE_string(event_model, "linear", "linear (g(x) = x, paper Eq. 2) | log (g(x) = log(x + b)).");
+DEFINE_double(log_offset, evfs::EventModelParams().log_offset, "b of the log event model.");
+DEFINE_string(spatial_tv, "anisotropic", "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | "
+              "isotropic (sqrt(dx^2+dy^2)).");
+DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale, "epsilon of the smoothed l1: sqrt(eps^2 + r^2) - eps.");
+DEFINE_bool(bounds, true, "Keep intensities in [0, 1].");
+DEFINE_int32(activity_radius_px, evfs::ReconstructionOptions().activity_radius_px, "Solve only pixels within this distance of an event of the "
+             "window; the others keep their initial value. -1 solves every pixel.");
+// Ceres.
+DEFINE_string(linear_solver, "CGNR", "Ceres linear solver: CGNR | SPARSE_NORMAL_CHOLESKY | "
+              "ITERATIVE_SCHUR | DENSE_QR ...");
+DEFINE_string(preconditioner, "JACOBI", "Ceres preconditioner: JACOBI | IDENTITY | ...");
+DEFINE_double(eta, evfs::DefaultSolverOptions().eta, "Inexact Newton forcing sequence: CG stops at relative residual eta.");
+DEFINE_int32(max_iterations, evfs::DefaultSolverOptions().max_num_iterations, "Most Levenberg-Marquardt iterations.");
+DEFINE_int32(max_linear_iterations, evfs::DefaultSolverOptions().max_linear_solver_iterations, "Most CG iterations per LM step.");
+DEFINE_double(max_time_s, 1e6, "Stop the solve after this many seconds.");
+DEFINE_double(function_tolerance, evfs::DefaultSolverOptions().function_tolerance, "Stop when the relative cost change falls below this.");
+DEFINE_int32(threads, evfs::DefaultSolverOptions().num_threads, "Threads for Jacobian evaluation and the linear solver.");
+DEFINE_bool(progress, false, "Print a line per iteration even when stderr is not a terminal.");
+// Simulator.
+DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos, "simulate: ON contrast threshold (log intensity).");
+DEFINE_double(threshold_neg, evfs::SimulatorOptions().contrast_threshold_neg, "simulate: OFF contrast threshold (log intensity).");
+DEFINE_double(threshold_sigma, evfs::SimulatorOptions().threshold_sigma, "simulate: per-pixel spread (std dev) of the thresholds.");
+DEFINE_double(refractory_s, 0.0, "simulate: refractory period in seconds.");
+DEFINE_double(noise_rate_hz, evfs::SimulatorOptions().noise_rate_hz, "simulate: background noise events per pixel per second.");
+DEFINE_uint64(seed, evfs::SimulatorOptions().seed, "simulate: random seed.");
+
+namespace evfs {
+namespace {
+
+constexpr char kUsage[] =
+    "event-driven video frame synthesis.\n\n"
+    "usage:\n"
+    "  evfs info        --data=DIR [--first=I --last=J]\n"
+    "  evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]\n"
+    "                   [--truth=K] --out=OUT [--fps=N] [solver and model flags]\n"
+    "  evfs simulate    --frames=DIR --out=DIR [--threshold_pos=0.2 --threshold_neg=0.2 "
+    "--seed=42]\n"
+    "  evfs convert     --data=DIR|FILE.h5 --out=FILE.h5|DIR\n"
+    "  evfs demo        --out=DIR\n\n"
+    "DIR is a folder in the Event Camera Dataset layout (events.txt 't x y p', images.txt\n"
+    "'t path', images/, optional exposures.txt 'path t_start t_end') or an .h5 file.\n"
+    "I, J, K are 0-based lines of images.txt. Example:\n"
+    "  evfs reconstruct --data=../shared/data/slider_depth_70_71 --mode=predict --first=0 "
+    "--last=1 --truth=1 --out=out/slider\n"
+    "Run 'evfs --helpon=evfs_main' for every flag.";
+
+void Require(bool condition, const std::string& message) {
+  if (!condition) throw InvalidArgumentError(message);
+}
+
+int RunInfo() {
+  Require(!FLAGS_data.empty(), "info needs --data=DIR or --data=FILE.h5");
+  const auto source = DataSource::Open(FLAGS_data);
+  const EventSummary events = source->Summarize();
+  std::printf("data        %s\n", source->path().c_str());
+  std::printf("resolution  %dx%d\n", source->width(), source->height());
+  std::printf("events      %lld (%lld ON, %lld OFF)\n", static_cast<long long>(events.count),
+              static_cast<long long>(events.positive),
+              static_cast<long long>(events.count - events.positive));
+  if (events.count > 0) {
+    const double span_s = NanosecondsToSeconds(events.t_last_ns - events.t_first_ns);
+    std::printf("time span   %.6f s .. %.6f s (%.6f s)\n", NanosecondsToSeconds(events.t_first_ns),
+                NanosecondsToSeconds(events.t_last_ns), span_s);
+    if (span_s > 0) std::printf("event rate  %.3f Mev/s\n", events.count / span_s / 1e6);
+  }
+  const auto& frames = source->frames();
+  std::printf("frames      %zu\n", frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    std::printf("  %3zu  t=%.6f s  %s", i, NanosecondsToSeconds(frames[i].t_ns),
+                frames[i].path.c_str());
+    if (frames[i].has_exposure) {
+      std::printf("  exposure %.6f .. %.6f s (%.1f ms)",
+                  NanosecondsToSeconds(frames[i].exposure_begin_ns),
+                  NanosecondsToSeconds(frames[i].exposure_end_ns),
+                  1e3 * NanosecondsToSeconds(frames[i].exposure_end_ns -
+                                             frames[i].exposure_begin_ns));
+    }
+    std::printf("\n");
+  }
+  if (FLAGS_first >= 0) {
+    const int count = static_cast<int>(frames.size());
+    const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
+    Require(FLAGS_first < count && last < count && last > FLAGS_first,
+            "--first/--last must be frame indices with first < last < " + std::to_string(count));
+    const int64_t begin_ns = frames[FLAGS_first].t_ns, end_ns = frames[last].t_ns;
+    const EventStream window = source->ReadEvents(begin_ns, end_ns);
+    const EventFrames collision = BinByCollision(window, begin_ns, end_ns);
+    std::printf("window      frames %d..%d, %.6f s: %zu events, %d collision frames\n",
+                FLAGS_first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(),
+                collision.num_frames());
+  }
+  return 0;
+}
+
+int RunConvert() {
+  Require(!FLAGS_data.empty() && !FLAGS_out.empty(), "convert needs --data and --out");
+  ConvertRecording(FLAGS_data, FLAGS_out);
+  std::printf("wrote %s\n", FLAGS_out.c_str());
+  return 0;
+}
+
+int RunSimulate() {
+  Require(!FLAGS_frames.empty() && !FLAGS_out.empty(), "simulate needs --frames=DIR and --out=DIR");
+  SimulatorOptions options;
+  options.contrast_threshold_pos = FLAGS_threshold_pos;
+  options.contrast_threshold_neg = FLAGS_threshold_neg;
+  options.threshold_sigma = FLAGS_threshold_sigma;
+  options.refractory_period_ns = SecondsToNanoseconds(FLAGS_refractory_s);
+  options.noise_rate_hz = FLAGS_noise_rate_hz;
+  options.seed = FLAGS_seed;
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
+
+  const std::filesystem::path folder(FLAGS_frames);
+  std::vector<FrameInfo> frames = ReadFrameList((folder / "images.txt").string());
+  Require(frames.size() >= 2, (folder / "images.txt").string() + ": simulate needs at least 2 frames");
+  Video video;
+  std::vector<Image> images;
+  for (const FrameInfo& frame : frames) {
+    images.push_back(ReadGreyImage((folder / frame.path).string()));
+    if (!video.empty() && (images.back().rows() != video.height() ||
+                           images.back().cols() != video.width())) {
+      throw InputError(InputError::Kind::kSizeMismatch, (folder / frame.path).string(), 0,
+                       "expected a " + std::to_string(video.width()) + "x" +
+                           std::to_string(video.height()) + " image like the first frame");
+    }
+    video.AppendFrame(images.back(), frame.t_ns);
+  }
+  const EventStream events = SimulateEvents(video, options);
+  WriteDataFolder(FLAGS_out, events, frames, images);
+  std::printf("simulated %zu events over %zu frames (%dx%d) into %s\n", events.size(),
+              frames.size(), video.width(), video.height(), FLAGS_out.c_str());
+  return 0;
+}
+
+// One progress line per Ceres iteration.
+class ProgressPrinter : public ceres::IterationCallback {
+ public:
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    std::fprintf(stderr, "iter %3d  cost %.6e  change %+.3e  cg %3d  %.2f s\n",
+                 summary.iteration, summary.cost, -summary.cost_change,
+                 summary.linear_solver_iterations, summary.cumulative_time_in_seconds);
+    return ceres::SOLVER_CONTINUE;
+  }
+};
+
+ReconstructRequest RequestFromFlags() {
+  ReconstructRequest request;
+  request.data_path = FLAGS_data;
+  request.mode = ParseMode(FLAGS_mode);
+  request.first = FLAGS_first;
+  request.last = FLAGS_last;
+  request.truth = FLAGS_truth;
+  request.exposure_s = FLAGS_exposure_s;
+  request.fps = FLAGS_fps;
+
+  BinningOptions& binning = request.binning;
+  if (FLAGS_binning == "auto") {
+    binning.method = BinningOptions::Method::kAuto;
+  } else if (FLAGS_binning == "collision") {
+    binning.method = BinningOptions::Method::kCollision;
+  } else if (FLAGS_binning == "stacked") {
+    binning.method = BinningOptions::Method::kStacked;
+  } else {
+    throw InvalidArgumentError("--binning must be auto, collision or stacked");
+  }
+  binning.max_latent_frames = FLAGS_max_latent_frames;
+  binning.max_latent_voxels = FLAGS_max_latent_voxels;
+  binning.stacked.num_frames = FLAGS_stacked_frames;
+
+  ObjectiveOptions& objective = request.options.objective;
+  objective.frame_weight = FLAGS_frame_weight;
+  objective.event_weight = FLAGS_event_weight;
+  objective.spatial_tv_weight = FLAGS_spatial_tv_weight;
+  objective.temporal_tv_weight = FLAGS_temporal_tv_weight;
+  objective.event_model.alpha = FLAGS_alpha;
+  objective.event_model.log_offset = FLAGS_log_offset;
+  objective.smoothing_scale = FLAGS_smoothing_scale;
+  Require(ParseEventModel(FLAGS_event_model, &objective.event_model.model),
+          "--event_model must be linear or log");
+  Require(ParseSpatialTv(FLAGS_spatial_tv, &objective.spatial_tv),
+          "--spatial_tv must be paper, anisotropic or isotropic");
+  request.options.bound_intensities = FLAGS_bounds;
+  request.options.activity_radius_px = FLAGS_activity_radius_px;
+
+  ceres::Solver::Options& solver = request.options.solver;
+  Require(ceres::StringToLinearSolverType(FLAGS_linear_solver, &solver.linear_solver_type),
+          "unknown --linear_solver " + FLAGS_linear_solver);
+  Require(ceres::StringToPreconditionerType(FLAGS_preconditioner, &solver.preconditioner_type),
+          "unknown --preconditioner " + FLAGS_preconditioner);
+  solver.eta = FLAGS_eta;
+  solver.max_num_iterations = FLAGS_max_iterations;
+  solver.max_linear_solver_iterations = FLAGS_max_linear_iterations;
+  solver.max_solver_time_in_seconds = FLAGS_max_time_s;
+  solver.function_tolerance = FLAGS_function_tolerance;
+  solver.num_threads = FLAGS_threads;
+  return request;
+}
+
+int RunReconstruct() {
+  Require(!FLAGS_data.empty(), "reconstruct needs --data=DIR or --data=FILE.h5");
+  Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
+  Require(FLAGS_first >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
+  ReconstructRequest request = RequestFromFlags();
+  ProgressPrinter progress;
+  if (FLAGS_progress || ::isatty(STDERR_FILENO)) {
+    request.options.solver.callbacks.push_back(&progress);
+    request.options.solver.update_state_every_iteration = false;
+  }
+  ReconstructResult result = RunReconstruction(request);
+  WriteReconstruction(request, &result, FLAGS_out);
+
+  const ReconstructionSummary& summary = result.reconstruction.summary;
+  std::printf("%s: %dx%d, %lld events, %d event frames, %d latent frames\n",
+              ModeName(result.mode), result.width, result.height,
+              static_cast<long long>(result.events), result.event_frames,
+              result.reconstruction.video.num_frames());
+  std::printf("model: %s\n", result.model.description.c_str());
+  if (summary.solved) {
+    std::printf("solve: %d iterations, cost %.6g -> %.6g (%s)\n", summary.iterations,
+                summary.initial_cost, summary.final_cost,
+                ceres::TerminationTypeToString(summary.ceres.termination_type));
+  } else {
+    std::printf("solve: skipped (%s)\n", summary.skipped_reason.c_str());
+  }
+  if (result.has_truth) {
+    std::printf("truth: frame %d vs latent %d: PSNR %.2f dB, SSIM %.4f (%s: %.2f dB, %.4f)\n",
+                result.truth.index, result.truth.latent_index, result.truth.psnr,
+                result.truth.ssim, result.mode == Mode::kInterpolate ? "blend" : "copy",
+                result.truth.baseline_psnr, result.truth.baseline_ssim);
+  }
+  std::printf("time: read %.2f s, bin %.3f s, build %.2f s, solve %.2f s, write %.2f s, "
+              "total %.2f s\n",
+              result.time.read_s, result.time.bin_s, result.time.build_s, result.time.solve_s,
+              result.time.write_s, result.time.total_s);
+  std::printf("wrote %d frames to %s\n", result.output.num_frames(), FLAGS_out.c_str());
+  return 0;
+}
+
+int RunCommand(const std::string& command) {
+  if (command == "info") return RunInfo();
+  if (command == "reconstruct") return RunReconstruct();
+  if (command == "simulate") return RunSimulate();
+  if (command == "convert") return RunConvert();
+  if (command == "demo") {
+    Require(!FLAGS_out.empty(), "demo needs --out=DIR");
+    return RunDemo(FLAGS_out);
+  }
+  throw InvalidArgumentError("unknown command '" + command +
+                             "': expected info, reconstruct, simulate, convert or demo "
+                             "(evfs --help)");
+}
+
+}  // namespace
+}  // namespace evfs
+
+int main(int argc, char** argv) {
+  gflags::SetUsageMessage(evfs::kUsage);
+  gflags::SetVersionString("0.1.0");
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  FLAGS_logtostderr = true;
+  google::InitGoogleLogging(argv[0]);
+  if (argc != 2) {
+    std::fprintf(stderr, "evfs: expected one command; see 'evfs --help'\n");
+    return 2;
+  }
+  try {
+    return evfs::RunCommand(argv[1]);
+  } catch (const evfs::Error& error) {
+    std::fprintf(stderr, "evfs %s: %s\n", argv[1], error.what());
+    return 2;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "evfs %s: unexpected error: %s\n", argv[1], error.what());
+    return 1;
+  }
+}

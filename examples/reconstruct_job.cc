@@ -1,0 +1,323 @@
+#include "examples/reconstruct_job.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/time.h"
+#include "examples/json_writer.h"
+#include "io/data_source.h"
+#include "io/image_io.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void CheckFrameIndex(const DataSource& source, int index, const char* what) {
+  const int count = static_cast<int>(source.frames().size());
+  if (index < 0 || index >= count) {
+    throw InvalidArgumentError(std::string(what) + " frame " + std::to_string(index) +
+                               " is out of range: " + source.path() + " has " +
+                               std::to_string(count) + " frames (0.." +
+                               std::to_string(count - 1) + ")");
+  }
+}
+
+TimedFrame ReadSharpFrame(const DataSource& source, int index) {
+  TimedFrame frame;
+  frame.image = source.ReadImage(index);
+  frame.exposure_begin_ns = frame.exposure_end_ns = source.frames()[index].t_ns;
+  frame.label = source.frames()[index].path;
+  return frame;
+}
+
+TimedFrame ReadBlurredFrame(const DataSource& source, int index, double exposure_s) {
+  const FrameInfo& info = source.frames()[index];
+  TimedFrame frame;
+  frame.label = info.path;
+  if (info.has_exposure) {
+    frame.exposure_begin_ns = info.exposure_begin_ns;
+    frame.exposure_end_ns = info.exposure_end_ns;
+  } else if (exposure_s > 0.0) {
+    const int64_t half_ns = SecondsToNanoseconds(exposure_s / 2.0);
+    frame.exposure_begin_ns = info.t_ns - half_ns;
+    frame.exposure_end_ns = info.t_ns + half_ns;
+  } else {
+    throw InvalidArgumentError("deblur needs the exposure of " + info.path +
+                               ": the data has no exposures.txt entry for it; pass --exposure_s");
+  }
+  frame.image = source.ReadImage(index);
+  return frame;
+}
+
+Video Resample(const Video& latent, double fps) {
+  const int64_t begin_ns = latent.timestamp_ns(0);
+  const int64_t end_ns = latent.timestamp_ns(latent.num_frames() - 1);
+  const double step_ns = static_cast<double>(kNanosecondsPerSecond) / fps;
+  Video output;
+  for (int i = 0;; ++i) {
+    const int64_t t_ns = begin_ns + static_cast<int64_t>(std::llround(i * step_ns));
+    if (t_ns > end_ns) break;
+    output.AppendFrame(latent.InterpolateAt(t_ns), t_ns);
+  }
+  return output;
+}
+
+}  // namespace
+
+Mode ParseMode(const std::string& name) {
+  if (name == "interpolate") return Mode::kInterpolate;
+  if (name == "predict") return Mode::kPredict;
+  if (name == "deblur") return Mode::kDeblur;
+  throw InvalidArgumentError("unknown mode '" + name +
+                             "': expected interpolate, predict or deblur");
+}
+
+const char* ModeName(Mode mode) {
+  switch (mode) {
+    case Mode::kInterpolate:
+      return "interpolate";
+    case Mode::kPredict:
+      return "predict";
+    case Mode::kDeblur:
+      return "deblur";
+  }
+  return "";
+}
+
+ReconstructResult RunReconstruction(const ReconstructRequest& request) {
+  const auto total_start = Clock::now();
+  std::string error;
+  if (!request.options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
+  if (!request.binning.IsValid(&error)) throw InvalidArgumentError("invalid binning: " + error);
+  if (!request.estimation.IsValid(&error)) throw InvalidArgumentError(error);
+  if (request.fps < 0.0 || !std::isfinite(request.fps)) {
+    throw InvalidArgumentError("--fps must be positive (or 0 for the latent timeline)");
+  }
+
+  ReconstructResult result;
+  result.mode = request.mode;
+  const auto read_start = Clock::now();
+  const std::unique_ptr<DataSource> source = DataSource::Open(request.data_path);
+  result.width = source->width();
+  result.height = source->height();
+  CheckFrameIndex(*source, request.first, "the first");
+  const int last = request.last >= 0 ? request.last : request.first + 1;
+  if (request.mode != Mode::kDeblur) {
+    CheckFrameIndex(*source, last, "the last");
+    if (last <= request.first) {
+      throw InvalidArgumentError("--last (" + std::to_string(last) +
+                                 ") must come after --first (" + std::to_string(request.first) +
+                                 ")");
+    }
+  }
+  if (request.truth >= 0) CheckFrameIndex(*source, request.truth, "the truth");
+
+  std::vector<TimedFrame> frames;
+  int64_t window_begin_ns = 0, window_end_ns = 0;
+  switch (request.mode) {
+    case Mode::kInterpolate:
+      frames = {ReadSharpFrame(*source, request.first), ReadSharpFrame(*source, last)};
+      window_begin_ns = frames.front().exposure_begin_ns;
+      window_end_ns = frames.back().exposure_end_ns;
+      break;
+    case Mode::kPredict:
+      frames = {ReadSharpFrame(*source, request.first)};
+      window_begin_ns = frames.front().exposure_begin_ns;
+      window_end_ns = source->frames()[last].t_ns;
+      break;
+    case Mode::kDeblur:
+      frames = {ReadBlurredFrame(*source, request.first, request.exposure_s)};
+      window_begin_ns = frames.front().exposure_begin_ns;
+      window_end_ns = frames.front().exposure_end_ns;
+      break;
+  }
+  const EventStream events = source->ReadEvents(window_begin_ns, window_end_ns);
+  Image truth_image;
+  if (request.truth >= 0) truth_image = source->ReadImage(request.truth);
+  result.time.read_s = SecondsSince(read_start);
+
+  const auto bin_start = Clock::now();
+  const Scene scene = MakeScene(frames, events, window_begin_ns, window_end_ns, request.binning);
+  result.events = scene.num_events;
+  result.event_frames = scene.events.num_frames();
+  result.time.bin_s = SecondsSince(bin_start);
+
+  ReconstructionOptions options = request.options;
+  if (options.objective.event_model.alpha <= 0.0) {
+    result.model = EstimateEventModel(scene, options.objective.event_model, request.estimation);
+    options.objective.event_model.alpha = result.model.alpha;
+    result.alpha_derived = true;
+  } else {
+    result.model.alpha = options.objective.event_model.alpha;
+    result.model.description = "alpha " + std::to_string(result.model.alpha) + " (given)";
+  }
+
+  result.baseline = InitializeLatentVideo(scene);
+  result.reconstruction = Reconstruct(scene, options);
+  result.time.build_s = result.reconstruction.summary.build_time_s;
+  result.time.solve_s = result.reconstruction.summary.solve_time_s;
+  const Video& latent = result.reconstruction.video;
+  result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
+
+  if (request.truth >= 0) {
+    TruthScore& truth = result.truth;
+    truth.index = request.truth;
+    truth.timestamp_ns = source->frames()[request.truth].t_ns;
+    if (truth.timestamp_ns < window_begin_ns || truth.timestamp_ns > window_end_ns) {
+      throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
+                                 " lies outside the reconstructed window");
+    }
+    truth.latent_index = latent.NearestFrame(truth.timestamp_ns);
+    const Image estimate = latent.frame(truth.latent_index);
+    truth.psnr = Psnr(estimate, truth_image);
+    truth.ssim = Ssim(estimate, truth_image);
+    const Image baseline = result.baseline.frame(truth.latent_index);
+    truth.baseline_psnr = Psnr(baseline, truth_image);
+    truth.baseline_ssim = Ssim(baseline, truth_image);
+    result.has_truth = true;
+  }
+  result.time.total_s = SecondsSince(total_start);
+  return result;
+}
+
+std::string SummaryJson(const ReconstructRequest& request, const ReconstructResult& result) {
+  const ReconstructionSummary& summary = result.reconstruction.summary;
+  const ReconstructionOptions& options = request.options;
+  const ObjectiveOptions& objective = options.objective;
+  JsonWriter json;
+  json.BeginObject();
+  json.Field("mode", ModeName(result.mode));
+  json.Field("data", request.data_path);
+  json.Field("width", result.width);
+  json.Field("height", result.height);
+  json.Field("events", result.events);
+  json.Field("event_frames", result.event_frames);
+  json.Field("latent_frames", result.reconstruction.video.num_frames());
+  json.Field("output_frames", result.output.num_frames());
+  json.Key("solver").BeginObject();
+  json.Field("name", "ceres_lm");
+  json.Field("linear_solver", ceres::LinearSolverTypeToString(options.solver.linear_solver_type));
+  json.Field("preconditioner", ceres::PreconditionerTypeToString(options.solver.preconditioner_type));
+  json.Field("eta", options.solver.eta);
+  json.Field("max_iterations", options.solver.max_num_iterations);
+  json.Field("function_tolerance", options.solver.function_tolerance);
+  json.Field("threads", options.solver.num_threads);
+  json.Field("bounds", options.bound_intensities);
+  json.Field("termination", summary.solved ? ceres::TerminationTypeToString(
+                                                 summary.ceres.termination_type)
+                                           : "NOT_SOLVED");
+  json.Field("message", summary.solved ? summary.ceres.message : summary.skipped_reason);
+  json.EndObject();
+  json.Key("model").BeginObject();
+  json.Field("event_model", EventModelName(objective.event_model.model));
+  json.Field("alpha", result.model.alpha);
+  json.Field("alpha_derived", result.alpha_derived);
+  if (result.alpha_derived) {
+    json.Field("change_per_event", result.model.change_per_event);
+    json.Field("change_measured_from_frames", result.model.estimated_from_frames);
+  }
+  json.Field("frame_weight", objective.frame_weight);
+  json.Field("event_weight", objective.event_weight);
+  json.Field("spatial_tv_weight", objective.spatial_tv_weight);
+  json.Field("temporal_tv_weight", objective.temporal_tv_weight);
+  json.Field("spatial_tv", SpatialTvName(objective.spatial_tv));
+  json.Field("smoothing_scale", objective.smoothing_scale);
+  json.EndObject();
+  json.Field("solved", summary.solved);
+  json.Field("iterations", summary.iterations);
+  json.Field("initial_cost", summary.initial_cost);
+  json.Field("final_cost", summary.final_cost);
+  json.Key("pixels").BeginObject();
+  json.Field("active", summary.problem.active_pixels);
+  json.Field("skipped", summary.problem.skipped_pixels);
+  json.Field("activity_radius_px", options.activity_radius_px);
+  json.EndObject();
+  json.Key("problem").BeginObject();
+  json.Field("parameter_blocks", summary.problem.parameter_blocks);
+  json.Field("residual_blocks", summary.problem.residual_blocks());
+  json.Field("frame_residuals", summary.problem.frame_residuals);
+  json.Field("event_residuals", summary.problem.event_residuals);
+  json.Field("spatial_tv_residuals", summary.problem.spatial_tv_residuals);
+  json.Field("temporal_tv_residuals", summary.problem.temporal_tv_residuals);
+  json.EndObject();
+  json.Key("time_s").BeginObject();
+  json.Field("read", result.time.read_s);
+  json.Field("bin", result.time.bin_s);
+  json.Field("build", result.time.build_s);
+  json.Field("solve", result.time.solve_s);
+  json.Field("write", result.time.write_s);
+  json.Field("total", result.time.total_s);
+  json.EndObject();
+  if (result.has_truth) {
+    const TruthScore& truth = result.truth;
+    json.Key("truth").BeginObject();
+    json.Field("index", truth.index);
+    json.Field("timestamp_s", NanosecondsToSeconds(truth.timestamp_ns));
+    json.Field("latent_index", truth.latent_index);
+    json.Field("psnr", truth.psnr);
+    json.Field("ssim", truth.ssim);
+    json.Field("baseline", result.mode == Mode::kInterpolate ? "blend" : "copy");
+    json.Field("baseline_psnr", truth.baseline_psnr);
+    json.Field("baseline_ssim", truth.baseline_ssim);
+    json.EndObject();
+  }
+  json.EndObject();
+  return json.str();
+}
+
+void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
+                         const std::string& out_dir) {
+  const auto write_start = Clock::now();
+  const fs::path out = fs::absolute(fs::path(out_dir)).lexically_normal();
+  const fs::path partial = out.parent_path() / (out.filename().string() + ".partial-" +
+                                                std::to_string(::getpid()));
+  std::error_code ec;
+  fs::remove_all(partial, ec);
+  if (!fs::create_directories(partial / "frames", ec) || ec) {
+    throw InputError(InputError::Kind::kUnwritable, out.string(), 0,
+                     "cannot create the output folder (" + ec.message() + ")");
+  }
+  try {
+    char name[32];
+    for (int t = 0; t < result->output.num_frames(); ++t) {
+      std::snprintf(name, sizeof(name), "%06d.png", t);
+      WriteGreyPng16((partial / "frames" / name).string(), result->output.frame(t));
+    }
+    WriteTimestampsTxt((partial / "timestamps.txt").string(), result->output.timestamps_ns());
+    result->time.write_s = SecondsSince(write_start);
+    result->time.total_s += result->time.write_s;
+    std::ofstream summary(partial / "summary.json");
+    summary << SummaryJson(request, *result) << "\n";
+    if (!summary) {
+      throw InputError(InputError::Kind::kUnwritable, (out / "summary.json").string(), 0,
+                       "cannot write the summary");
+    }
+    summary.close();
+    fs::remove_all(out, ec);
+    fs::rename(partial, out, ec);
+    if (ec) {
+      throw InputError(InputError::Kind::kUnwritable, out.string(), 0,
+                       "cannot move the finished output into place (" + ec.message() + ")");
+    }
+  } catch (...) {
+    fs::remove_all(partial, ec);
+    throw;
+  }
+}
+
+}  // namespace evfs

@@ -1,0 +1,92 @@
+#include "solver/reconstruction_options.h"
+
+#include <cmath>
+
+namespace evfs {
+namespace {
+
+bool IsNonNegativeFinite(double value) { return std::isfinite(value) && value >= 0.0; }
+
+}  // namespace
+
+bool ObjectiveOptions::IsValid(std::string* error) const {
+  if (!IsNonNegativeFinite(frame_weight) || !IsNonNegativeFinite(event_weight) ||
+      !IsNonNegativeFinite(spatial_tv_weight) || !IsNonNegativeFinite(temporal_tv_weight)) {
+    *error = "term weights must be finite and non-negative";
+    return false;
+  }
+  if (!(std::isfinite(smoothing_scale) && smoothing_scale > 0.0)) {
+    *error = "smoothing_scale must be positive";
+    return false;
+  }
+  if (!std::isfinite(event_model.alpha)) {
+    *error = "alpha must be finite (<= 0 derives it from the data)";
+    return false;
+  }
+  if (event_model.model == EventModel::kLog &&
+      !(std::isfinite(event_model.log_offset) && event_model.log_offset > 0.0)) {
+    *error = "log_offset (b of log(x + b)) must be positive";
+    return false;
+  }
+  return true;
+}
+
+ceres::Solver::Options DefaultSolverOptions() {
+  ceres::Solver::Options options;
+  options.minimizer_type = ceres::TRUST_REGION;
+  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  options.linear_solver_type = ceres::CGNR;
+  options.preconditioner_type = ceres::JACOBI;
+  options.eta = 0.1;
+  options.max_num_iterations = 20;
+  options.max_linear_solver_iterations = 500;
+  options.function_tolerance = 1e-4;
+  options.gradient_tolerance = 1e-10;
+  options.parameter_tolerance = 1e-6;
+  options.num_threads = 2;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  return options;
+}
+
+const char* SpatialTvName(SpatialTv form) {
+  switch (form) {
+    case SpatialTv::kPaper:
+      return "paper";
+    case SpatialTv::kAnisotropic:
+      return "anisotropic";
+    case SpatialTv::kIsotropic:
+      return "isotropic";
+  }
+  return "";
+}
+
+bool ParseSpatialTv(const std::string& name, SpatialTv* form) {
+  for (const SpatialTv candidate :
+       {SpatialTv::kPaper, SpatialTv::kAnisotropic, SpatialTv::kIsotropic}) {
+    if (name == SpatialTvName(candidate)) {
+      *form = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* EventModelName(EventModel model) {
+  return model == EventModel::kLog ? "log" : "linear";
+}
+
+bool ParseEventModel(const std::string& name, EventModel* model) {
+  if (name != "linear" && name != "log") return false;
+  *model = name == "log" ? EventModel::kLog : EventModel::kLinear;
+  return true;
+}
+
+ReconstructionOptions::ReconstructionOptions() : solver(DefaultSolverOptions()) {}
+
+bool ReconstructionOptions::IsValid(std::string* error) const {
+  if (!objective.IsValid(error)) return false;
+  return solver.IsValid(error);
+}
+
+}  // namespace evfs

@@ -1,0 +1,78 @@
+// Everything that shapes a reconstruction: the objective (DESIGN.md §1), its initialisation and
+// the Ceres solver settings.
+#ifndef EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
+#define EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
+
+#include <string>
+
+#include <ceres/ceres.h>
+
+#include "cost_functions/event_model.h"
+#include "cost_functions/spatial_tv_residual.h"
+
+namespace evfs {
+
+/// The objective's weights and model. Every term is a smoothed ℓ1 penalty summed over its
+/// residuals and divided by the number of pixels h·w, and the spatial TV also by the number of
+/// latent frames. So the weights depend neither on the resolution nor on how finely binning
+/// slices the window: the event and temporal terms sum over time (the number of events and the
+/// path length of a pixel's intensity do not grow with K), the spatial TV is a mean over frames
+/// (summed, it would blur more the more latent frames there are).
+struct ObjectiveOptions {
+  /// Weight of the frame term (paper Eq. 3), per frame observation.
+  double frame_weight = 1.0;
+  /// λ_e: weight of the event term (paper Eq. 2), per event frame.
+  double event_weight = 0.7;
+  /// λ_xy: weight of spatial total variation (paper Eq. 4), mean over latent frames.
+  double spatial_tv_weight = 2.0;
+  /// λ_t: weight of temporal total variation (paper Eq. 5), per latent step.
+  double temporal_tv_weight = 1.5;
+  /// g and α of the event model; α <= 0 means "derive it from the data".
+  EventModelParams event_model;
+  /// Form of the spatial TV.
+  SpatialTv spatial_tv = SpatialTv::kAnisotropic;
+  /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
+  double smoothing_scale = 0.05;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct ReconstructionOptions {
+  ObjectiveOptions objective;
+
+  enum class Initialization {
+    kBlend,  // linear blend in time of the frame observations (a copy when there is one)
+  };
+  Initialization initialization = Initialization::kBlend;
+
+  /// Keep every intensity in [0, 1] (Ceres parameter bounds).
+  bool bound_intensities = true;
+
+  /// Pixels farther than this (Chebyshev distance, pixels) from every event of the window keep
+  /// their initial value and get no parameter blocks or residuals; < 0 solves every pixel.
+  int activity_radius_px = 2;
+
+  /// Ceres settings, all of them available to library users; the defaults below are set by
+  /// DefaultSolverOptions() (Levenberg–Marquardt, CGNR with a Jacobi preconditioner).
+  ceres::Solver::Options solver;
+
+  ReconstructionOptions();
+  bool IsValid(std::string* error) const;
+};
+
+/// The Ceres settings evfs uses by default. Per-voxel scalar parameter blocks make the normal
+/// equations a 3-D grid Laplacian-like system: sparse Cholesky fills in badly on it (a
+/// prototype measured nnz(L) = 1.9e7 for 45k unknowns), so an inexact Newton step with CGNR and
+/// a Jacobi preconditioner is used (../shared/notes/solver-measurements.md).
+ceres::Solver::Options DefaultSolverOptions();
+
+/// Names used by flags and summaries: "paper", "anisotropic", "isotropic" and "linear", "log".
+const char* SpatialTvName(SpatialTv form);
+/// Parses a name of SpatialTvName; false when unknown.
+bool ParseSpatialTv(const std::string& name, SpatialTv* form);
+const char* EventModelName(EventModel model);
+bool ParseEventModel(const std::string& name, EventModel* model);
+
+}  // namespace evfs
+
+#endif  // EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_

@@ -1,0 +1,46 @@
+#include "solver/reconstructor.h"
+
+#include <chrono>
+
+#include "core/error.h"
+
+namespace evfs {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
+  if (options.objective.event_model.alpha <= 0.0) {
+    throw InvalidArgumentError("alpha must be positive; derive it with EstimateAlpha first");
+  }
+
+  Reconstruction result;
+  result.video = InitializeLatentVideo(scene);
+  ReconstructionSummary& summary = result.summary;
+  if (scene.num_events == 0) {
+    summary.skipped_reason = "no events in the window: the initialisation is the answer";
+    return result;
+  }
+
+  const auto build_start = std::chrono::steady_clock::now();
+  const std::unique_ptr<BuiltProblem> built = ProblemBuilder(scene, options).Build(&result.video);
+  summary.build_time_s = SecondsSince(build_start);
+  summary.problem = built->statistics();
+
+  const auto solve_start = std::chrono::steady_clock::now();
+  ceres::Solve(options.solver, &built->problem(), &summary.ceres);
+  summary.solve_time_s = SecondsSince(solve_start);
+  summary.solved = true;
+  summary.initial_cost = summary.ceres.initial_cost;
+  summary.final_cost = summary.ceres.final_cost;
+  summary.iterations = static_cast<int>(summary.ceres.iterations.size()) - 1;
+  return result;
+}
+
+}  // namespace evfs

@@ -1,0 +1,40 @@
+// Scene → latent video: builds the problem, initialises, solves with Ceres and reports.
+#ifndef EVFS_SOLVER_RECONSTRUCTOR_H_
+#define EVFS_SOLVER_RECONSTRUCTOR_H_
+
+#include <string>
+
+#include <ceres/ceres.h>
+
+#include "core/video.h"
+#include "solver/problem_builder.h"
+#include "solver/reconstruction_options.h"
+#include "solver/scene.h"
+
+namespace evfs {
+
+/// What a reconstruction did: Ceres' own summary plus evfs' counts and timings.
+struct ReconstructionSummary {
+  ceres::Solver::Summary ceres;
+  ProblemStatistics problem;
+  bool solved = false;         // false when the scene needed no solve
+  std::string skipped_reason;  // why not, when solved is false
+  double build_time_s = 0.0;
+  double solve_time_s = 0.0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+};
+
+struct Reconstruction {
+  Video video;  // H_0 … H_K with their latent timestamps
+  ReconstructionSummary summary;
+};
+
+/// Reconstructs the latent video of `scene`. Throws InvalidArgumentError for invalid options.
+/// A scene without events is answered with its initialisation, without a solve.
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options);
+
+}  // namespace evfs
+
+#endif  // EVFS_SOLVER_RECONSTRUCTOR_H_

@@ -1,0 +1,87 @@
+// A reconstruction problem as data: what was observed (frames with their exposure spans, event
+// frames with their latent spans) on one latent timeline (DESIGN.md §1–2). Interpolation,
+// prediction and deblurring are presets of this one structure; the solver never branches on
+// the case.
+#ifndef EVFS_SOLVER_SCENE_H_
+#define EVFS_SOLVER_SCENE_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/event_frames.h"
+#include "core/event_stream.h"
+#include "core/video.h"
+#include "events/binning.h"
+
+namespace evfs {
+
+/// An intensity frame as recorded: sharp when exposure_begin_ns == exposure_end_ns, otherwise
+/// the time average of the scene over its exposure (a motion-blurred frame).
+struct TimedFrame {
+  Image image;
+  int64_t exposure_begin_ns = 0;
+  int64_t exposure_end_ns = 0;
+  std::string label;  // where it came from, for messages ("images/frame_00000070.png")
+};
+
+/// One frame observation on the latent timeline: F_j = mean(H_a … H_b).
+struct FrameObservation {
+  Image image;
+  int latent_first = 0;
+  int latent_last = 0;
+  std::string label;
+};
+
+/// How events are binned into event frames (paper §3.3).
+struct BinningOptions {
+  enum class Method {
+    kAuto,       // collision binning unless it yields more than max_latent_frames frames
+    kCollision,  // the paper's Binning 1: one step per collision frame, values in {-1, 0, 1}
+    kStacked,    // the paper's Binning 2: StackedBinningOptions
+  };
+  Method method = Method::kAuto;
+  /// kAuto: the most latent steps; above it, stacked equal-time binning with this many frames
+  /// is used instead (memory and time grow linearly with latent frames).
+  int max_latent_frames = 48;
+  /// kAuto: the most latent voxels (pixels × latent frames): large sensors get fewer steps, at
+  /// least 4. Ceres needs about 1 GB per million voxels.
+  int64_t max_latent_voxels = 2000000;
+  StackedBinningOptions stacked;  // used by kStacked
+
+  bool IsValid(std::string* error) const;
+};
+
+struct Scene {
+  int height = 0;
+  int width = 0;
+  std::vector<FrameObservation> frames;
+  /// Event frames; their spans and latent_timestamps_ns() define the latent timeline.
+  EventFrames events;
+  int64_t num_events = 0;  // events binned into `events`
+
+  int num_latent_frames() const { return static_cast<int>(events.latent_timestamps_ns().size()); }
+  const std::vector<int64_t>& latent_timestamps_ns() const {
+    return events.latent_timestamps_ns();
+  }
+};
+
+/// Builds the general scene: bins `events` over [window_begin_ns, window_end_ns), then ties
+/// each frame to the latent frames of its exposure (a sharp frame to the nearest latent frame).
+/// Throws InvalidArgumentError when a frame lies outside the window or sizes disagree.
+Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events,
+                int64_t window_begin_ns, int64_t window_end_ns, const BinningOptions& binning);
+
+/// Interpolation (paper §3.2): sharp frames at both ends of the window.
+Scene MakeInterpolationScene(const TimedFrame& first, const TimedFrame& last,
+                             const EventStream& events, const BinningOptions& binning);
+/// Prediction: a sharp frame at the start and events up to window_end_ns.
+Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns,
+                          const EventStream& events, const BinningOptions& binning);
+/// Motion deblur: one blurred frame whose exposure is the window.
+Scene MakeDeblurScene(const TimedFrame& blurred, const EventStream& events,
+                      const BinningOptions& binning);
+
+}  // namespace evfs
+
+#endif  // EVFS_SOLVER_SCENE_H_
