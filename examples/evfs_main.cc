@@ -118,9 +118,14 @@ int RunInfo() {
   const EventSummary events = source->Summarize();
   std::printf("data        %s\n", source->path().c_str());
   std::printf("resolution  %dx%d\n", source->width(), source->height());
-  std::printf("events      %lld (%lld ON, %lld OFF)\n", static_cast<long long>(events.count),
-              static_cast<long long>(events.positive),
-              static_cast<long long>(events.count - events.positive));
+  if (source->has_events()) {
+    std::printf("events      %lld (%lld ON, %lld OFF)\n", static_cast<long long>(events.count),
+                static_cast<long long>(events.positive),
+                static_cast<long long>(events.count - events.positive));
+  } else {
+    std::printf("events      none: frames only (make events with 'evfs simulate --frames=%s "
+                "--out=DIR')\n", source->path().c_str());
+  }
   if (events.count > 0) {
     const double span_s = NanosecondsToSeconds(events.t_last_ns - events.t_first_ns);
     std::printf("time span   %.6f s .. %.6f s (%.6f s)\n", NanosecondsToSeconds(events.t_first_ns),
@@ -141,7 +146,7 @@ int RunInfo() {
     }
     std::printf("\n");
   }
-  if (FLAGS_first >= 0) {
+  if (FLAGS_first >= 0 && source->has_events()) {
     const int count = static_cast<int>(frames.size());
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
     Require(FLAGS_first < count && last < count && last > FLAGS_first,

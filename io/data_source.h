@@ -77,6 +77,8 @@ class DataSource {
   virtual EventStream ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const = 0;
   /// Every event of the recording.
   virtual EventStream ReadAllEvents() const = 0;
+  /// False for a folder of frames without events.txt.
+  virtual bool has_events() const { return true; }
   /// Counts and time range of all events (reads them all once, keeping none).
   virtual EventSummary Summarize() const = 0;
 

@@ -60,7 +60,16 @@ TextFolderDataSource::TextFolderDataSource(const std::string& folder, std::vecto
     : DataSource(folder, 0, 0, std::move(frames)) {
   const std::string events_txt = (fs::path(folder) / kEventsFile).string();
   if (!IsFile(events_txt)) {
-    throw InputError(InputError::Kind::kMissingFile, events_txt, 0, "events file does not exist");
+    // A folder of frames alone (a ground-truth clip to simulate events from) is a recording
+    // without events: it can be described and simulated, and reading its events says why not.
+    if (frames_.empty()) {
+      throw InputError(InputError::Kind::kMissingFile, events_txt, 0,
+                       "events file does not exist (and images.txt lists no frames)");
+    }
+    const Image first = ReadGreyImage((fs::path(folder) / frames_.front().path).string());
+    width_ = static_cast<int>(first.cols());
+    height_ = static_cast<int>(first.rows());
+    return;
   }
   if (!frames_.empty()) {
     const Image first = ReadGreyImage((fs::path(folder) / frames_.front().path).string());
@@ -93,13 +102,24 @@ Image TextFolderDataSource::ReadImage(int index) const {
   return image;
 }
 
-EventStream TextFolderDataSource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
-  return events_->Read(t_begin_ns, t_end_ns);
+const EventTextReader& TextFolderDataSource::events() const {
+  if (!events_) {
+    throw InputError(InputError::Kind::kMissingFile, (fs::path(path_) / kEventsFile).string(), 0,
+                     "this folder holds frames only; make events for it with "
+                     "'evfs simulate --frames=" + path_ + " --out=DIR'");
+  }
+  return *events_;
 }
 
-EventStream TextFolderDataSource::ReadAllEvents() const { return events_->ReadAll(); }
+EventStream TextFolderDataSource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
+  return events().Read(t_begin_ns, t_end_ns);
+}
 
-EventSummary TextFolderDataSource::Summarize() const { return events_->Summarize(); }
+EventStream TextFolderDataSource::ReadAllEvents() const { return events().ReadAll(); }
+
+EventSummary TextFolderDataSource::Summarize() const {
+  return events_ ? events_->Summarize() : EventSummary();
+}
 
 void WriteDataFolder(const std::string& folder, const EventStream& events,
                      const std::vector<FrameInfo>& frames, const std::vector<Image>& images) {

@@ -19,9 +19,13 @@ namespace evfs {
 /// it); a folder without frames takes it from the largest event coordinates.
 class TextFolderDataSource : public DataSource {
  public:
-  /// Reads images.txt and exposures.txt and maps events.txt. Throws InputError.
+  /// Reads images.txt and exposures.txt and maps events.txt. A folder without events.txt but
+  /// with frames is a frames-only recording: has_events() is false, Summarize() counts nothing
+  /// and reading events throws InputError saying how to simulate them. Throws InputError.
   explicit TextFolderDataSource(const std::string& folder);
   ~TextFolderDataSource() override;
+
+  bool has_events() const override { return events_ != nullptr; }
 
   Image ReadImage(int index) const override;
   EventStream ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const override;
@@ -30,6 +34,7 @@ class TextFolderDataSource : public DataSource {
 
  private:
   TextFolderDataSource(const std::string& folder, std::vector<FrameInfo> frames);
+  const EventTextReader& events() const;  // throws for a frames-only folder
 
   std::unique_ptr<EventTextReader> events_;
 };
