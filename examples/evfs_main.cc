@@ -284,7 +284,7 @@ int RunReconstruct() {
               ModeName(result.mode), result.width, result.height,
               static_cast<long long>(result.events), result.event_frames,
               result.reconstruction.video.num_frames());
-  std::printf("model: %s\n", result.model.description.c_str());
+  std::printf("model: %s\n", result.reconstruction.summary.model.description.c_str());
   if (summary.solved) {
     std::printf("solve: %d iterations, cost %.6g -> %.6g (%s)\n", summary.iterations,
                 summary.initial_cost, summary.final_cost,

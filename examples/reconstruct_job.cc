@@ -104,7 +104,6 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   std::string error;
   if (!request.options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
   if (!request.binning.IsValid(&error)) throw InvalidArgumentError("invalid binning: " + error);
-  if (!request.estimation.IsValid(&error)) throw InvalidArgumentError(error);
   if (request.fps < 0.0 || !std::isfinite(request.fps)) {
     throw InvalidArgumentError("--fps must be positive (or 0 for the latent timeline)");
   }
@@ -157,18 +156,8 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   result.event_frames = scene.events.num_frames();
   result.time.bin_s = SecondsSince(bin_start);
 
-  ReconstructionOptions options = request.options;
-  if (options.objective.event_model.alpha <= 0.0) {
-    result.model = EstimateEventModel(scene, options.objective.event_model, request.estimation);
-    options.objective.event_model.alpha = result.model.alpha;
-    result.alpha_derived = true;
-  } else {
-    result.model.alpha = options.objective.event_model.alpha;
-    result.model.description = "alpha " + std::to_string(result.model.alpha) + " (given)";
-  }
-
   result.baseline = InitializeLatentVideo(scene);
-  result.reconstruction = Reconstruct(scene, options);
+  result.reconstruction = Reconstruct(scene, request.options);
   result.time.build_s = result.reconstruction.summary.build_time_s;
   result.time.solve_s = result.reconstruction.summary.solve_time_s;
   const Video& latent = result.reconstruction.video;
@@ -225,11 +214,11 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json.EndObject();
   json.Key("model").BeginObject();
   json.Field("event_model", EventModelName(objective.event_model.model));
-  json.Field("alpha", result.model.alpha);
-  json.Field("alpha_derived", result.alpha_derived);
-  if (result.alpha_derived) {
-    json.Field("change_per_event", result.model.change_per_event);
-    json.Field("change_measured_from_frames", result.model.estimated_from_frames);
+  json.Field("alpha", result.reconstruction.summary.model.alpha);
+  json.Field("alpha_derived", result.reconstruction.summary.alpha_derived);
+  if (result.reconstruction.summary.alpha_derived) {
+    json.Field("change_per_event", result.reconstruction.summary.model.change_per_event);
+    json.Field("change_measured_from_frames", result.reconstruction.summary.model.estimated_from_frames);
   }
   json.Field("frame_weight", objective.frame_weight);
   json.Field("event_weight", objective.event_weight);

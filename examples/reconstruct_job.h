@@ -8,7 +8,6 @@
 #include <string>
 
 #include "core/video.h"
-#include "solver/event_model_estimation.h"
 #include "solver/reconstruction_options.h"
 #include "solver/reconstructor.h"
 #include "solver/scene.h"
@@ -32,7 +31,6 @@ struct ReconstructRequest {
   double fps = 0.0;         // > 0: resample the latent video to this uniform rate
   BinningOptions binning;
   ReconstructionOptions options;  // objective.event_model.alpha <= 0: derive α from the data
-  EventModelEstimationOptions estimation;
 };
 
 struct TruthScore {
@@ -55,8 +53,6 @@ struct ReconstructResult {
   Reconstruction reconstruction;  // latent video and solver summary
   Video output;                   // the latent video, or its resampling at request.fps
   Video baseline;                 // the initialisation (blend or copy) on the latent timeline
-  EventModelEstimate model;       // α and how it was derived (alpha_derived false: user's α)
-  bool alpha_derived = false;
   bool has_truth = false;
   TruthScore truth;
   StageTimes time;

@@ -85,7 +85,7 @@ bool ParseEventModel(const std::string& name, EventModel* model) {
 ReconstructionOptions::ReconstructionOptions() : solver(DefaultSolverOptions()) {}
 
 bool ReconstructionOptions::IsValid(std::string* error) const {
-  if (!objective.IsValid(error)) return false;
+  if (!objective.IsValid(error) || !estimation.IsValid(error)) return false;
   return solver.IsValid(error);
 }
 

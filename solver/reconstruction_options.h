@@ -9,6 +9,7 @@
 
 #include "cost_functions/event_model.h"
 #include "cost_functions/spatial_tv_residual.h"
+#include "solver/event_model_estimation.h"
 
 namespace evfs {
 
@@ -27,18 +28,28 @@ struct ObjectiveOptions {
   double spatial_tv_weight = 2.0;
   /// λ_t: weight of temporal total variation (paper Eq. 5), per latent step.
   double temporal_tv_weight = 1.5;
-  /// g and α of the event model; α <= 0 means "derive it from the data".
-  EventModelParams event_model;
+  /// g and α of the event model; α <= 0 (the default) derives α from the data
+  /// (EstimateEventModel).
+  EventModelParams event_model = DeriveAlpha();
   /// Form of the spatial TV.
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
 
   bool IsValid(std::string* error) const;
+
+ private:
+  static EventModelParams DeriveAlpha() {
+    EventModelParams params;
+    params.alpha = 0.0;
+    return params;
+  }
 };
 
 struct ReconstructionOptions {
   ObjectiveOptions objective;
+  /// How α is derived when objective.event_model.alpha <= 0.
+  EventModelEstimationOptions estimation;
 
   enum class Initialization {
     kBlend,  // linear blend in time of the frame observations (a copy when there is one)

@@ -16,11 +16,18 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
-  if (options.objective.event_model.alpha <= 0.0) {
-    throw InvalidArgumentError("alpha must be positive; derive it with EstimateAlpha first");
+  Reconstruction result;
+  ReconstructionOptions solve_options = options;
+  EventModelParams& event_model = solve_options.objective.event_model;
+  if (event_model.alpha <= 0.0) {
+    result.summary.model = EstimateEventModel(scene, event_model, options.estimation);
+    result.summary.alpha_derived = true;
+    event_model.alpha = result.summary.model.alpha;
+  } else {
+    result.summary.model.alpha = event_model.alpha;
+    result.summary.model.description = "alpha " + std::to_string(event_model.alpha) + " (given)";
   }
 
-  Reconstruction result;
   result.video = InitializeLatentVideo(scene);
   ReconstructionSummary& summary = result.summary;
   if (scene.num_events == 0) {
@@ -29,12 +36,12 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   }
 
   const auto build_start = std::chrono::steady_clock::now();
-  const std::unique_ptr<BuiltProblem> built = ProblemBuilder(scene, options).Build(&result.video);
+  const std::unique_ptr<BuiltProblem> built = ProblemBuilder(scene, solve_options).Build(&result.video);
   summary.build_time_s = SecondsSince(build_start);
   summary.problem = built->statistics();
 
   const auto solve_start = std::chrono::steady_clock::now();
-  ceres::Solve(options.solver, &built->problem(), &summary.ceres);
+  ceres::Solve(solve_options.solver, &built->problem(), &summary.ceres);
   summary.solve_time_s = SecondsSince(solve_start);
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;

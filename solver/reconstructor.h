@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 
 #include "core/video.h"
+#include "solver/event_model_estimation.h"
 #include "solver/problem_builder.h"
 #include "solver/reconstruction_options.h"
 #include "solver/scene.h"
@@ -17,6 +18,8 @@ namespace evfs {
 struct ReconstructionSummary {
   ceres::Solver::Summary ceres;
   ProblemStatistics problem;
+  EventModelEstimate model;    // the α used, and how it was derived when it was
+  bool alpha_derived = false;
   bool solved = false;         // false when the scene needed no solve
   std::string skipped_reason;  // why not, when solved is false
   double build_time_s = 0.0;
@@ -32,7 +35,8 @@ struct Reconstruction {
 };
 
 /// Reconstructs the latent video of `scene`. Throws InvalidArgumentError for invalid options.
-/// A scene without events is answered with its initialisation, without a solve.
+/// α <= 0 in the options is derived from the scene first. A scene without events is answered
+/// with its initialisation, without a solve.
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options);
 
 }  // namespace evfs

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include "core/metrics.h"
-#include "solver/event_model_estimation.h"
 #include "tests/solver/solver_test_scenes.h"
 
 namespace evfs {
@@ -18,13 +17,6 @@ constexpr double kMinGainOverBlendDb = 4.5;
 constexpr double kMinGainOverCopyDb = 6.0;
 constexpr double kMinGainOverBlurredDb = 2.5;
 
-ReconstructionOptions DerivedOptions(const Scene& scene) {
-  ReconstructionOptions options;
-  options.objective.event_model.alpha =
-      EstimateEventModel(scene, options.objective.event_model, EventModelEstimationOptions())
-          .alpha;
-  return options;
-}
 
 double PsnrAt(const Video& video, const testing::SyntheticRecording& recording, int truth) {
   const int index = video.NearestFrame(recording.rendered.timestamp_ns(truth));
@@ -35,8 +27,10 @@ TEST(Reconstructor, InterpolationBeatsTheBlend) {
   const testing::SyntheticRecording recording;
   const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
-  const Reconstruction result = Reconstruct(scene, DerivedOptions(scene));
+  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
   ASSERT_TRUE(result.summary.solved);
+  EXPECT_TRUE(result.summary.alpha_derived);
+  EXPECT_GT(result.summary.model.alpha, 0.0);
   EXPECT_LE(result.summary.final_cost, result.summary.initial_cost);
   const double blend = PsnrAt(InitializeLatentVideo(scene), recording, 10);
   const double solved = PsnrAt(result.video, recording, 10);
@@ -48,7 +42,7 @@ TEST(Reconstructor, PredictionBeatsTheCopy) {
   const testing::SyntheticRecording recording;
   const Scene scene = MakePredictionScene(recording.Sharp(0), recording.rendered.timestamp_ns(10),
                                           recording.events, BinningOptions());
-  const Reconstruction result = Reconstruct(scene, DerivedOptions(scene));
+  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
   const double copy = PsnrAt(InitializeLatentVideo(scene), recording, 10);
   const double solved = PsnrAt(result.video, recording, 10);
   std::printf("prediction: copy %.2f dB, evfs %.2f dB\n", copy, solved);
@@ -68,7 +62,7 @@ TEST(Reconstructor, MixedSharpAndBlurredObservationsSolveTogether) {
   ASSERT_EQ(scene.frames.size(), 2u);
   EXPECT_EQ(scene.frames[1].latent_first, 10);
   EXPECT_EQ(scene.frames[1].latent_last, 20);
-  const Reconstruction result = Reconstruct(scene, DerivedOptions(scene));
+  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
   ASSERT_TRUE(result.summary.solved);
   // The end of the window is inside the blurred exposure: the solve must sharpen it.
   const double blurred = Psnr(recording.Blurred(10, 20).image, recording.rendered.frame(20));
