@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# `make bench`: the micro-benchmarks, then the real-data reconstructions when the shared data
-# is present.   usage: benchmarks/run_all.sh [BUILD_DIR] [DATA_DIR]
+# `make bench`: the micro-benchmarks, then the reconstructions on the shared data when it is
+# present.   usage: benchmarks/run_all.sh [BUILD_DIR] [DATA_DIR]
 set -euo pipefail
 build=${1:-build}
 data=${2:-../shared/data}
@@ -11,8 +11,8 @@ echo "== event file parsing (io_benchmark)"
 
 if [ -d "$data" ]; then
   echo
-  echo "== reconstructions on the shared DAVIS snippets (default flags)"
-  bash benchmarks/real_data.sh "$build" "$data"
+  echo "== reconstructions on the shared data (default options; the simulated clips take long)"
+  "$build/benchmarks/reconstruction_benchmark" --data="$data" --csv="$build/reconstruction.csv"
 else
   echo "no shared data folder at $data: skipping the real-data runs"
 fi

@@ -1,0 +1,227 @@
+// Reconstruction quality and wall time with the default options on the shared data: the real
+// DAVIS snippets (slider_depth prediction, shapes_rotation interpolation, eslnet_cups deblur)
+// and the 240 fps clips with events simulated by `evfs simulate`'s defaults (interpolation of
+// frame 2 from frames 0 and 4; deblurring the mean of frames 0–7). Prints a Markdown table and
+// optionally writes CSV.
+//
+//   reconstruction_benchmark --data=../shared/data [--cases=slider,shapes,cups,clips]
+//                            [--clips=nfs_basketball_7,adobe240_GOPR9637b,...] [--csv=FILE]
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include "core/error.h"
+#include "core/metrics.h"
+#include "events/simulator.h"
+#include "examples/reconstruct_job.h"
+#include "io/frame_list.h"
+#include "io/image_io.h"
+#include "solver/reconstructor.h"
+
+DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
+DEFINE_string(cases, "slider,shapes,cups,clips", "Comma-separated cases to run.");
+DEFINE_string(clips,
+              "nfs_basketball_7,adobe240_GOPR9637b,adobe240_GOPR9642,adobe240_IMG_0004b,"
+              "adobe240_IMG_0036",
+              "Ground-truth clips for the simulated-event cases.");
+DEFINE_string(csv, "", "Also write the rows as CSV to this file.");
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Row {
+  std::string data, method_case, metric;
+  double baseline = 0.0, evfs = 0.0;
+  std::string baseline_name;
+  int latent_frames = 0;
+  double wall_s = 0.0;
+};
+
+std::vector<std::string> Split(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  for (std::string part; std::getline(stream, part, ',');) {
+    if (!part.empty()) parts.push_back(part);
+  }
+  return parts;
+}
+
+bool Wants(const std::string& name) {
+  for (const std::string& c : Split(FLAGS_cases)) {
+    if (c == name) return true;
+  }
+  return false;
+}
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void PrintRow(const Row& row) {
+  std::printf("| %s | %s | %s | %s %.2f | %.2f | %+.2f | %d | %.1f s |\n", row.data.c_str(),
+              row.method_case.c_str(), row.metric.c_str(), row.baseline_name.c_str(),
+              row.baseline, row.evfs, row.evfs - row.baseline, row.latent_frames, row.wall_s);
+  std::fflush(stdout);
+}
+
+// A held-out frame of a real snippet, through the same job as `evfs reconstruct`.
+Row RunTruthCase(const std::string& snippet, Mode mode, int first, int last, int truth) {
+  ReconstructRequest request;
+  request.data_path = (fs::path(FLAGS_data) / snippet).string();
+  request.mode = mode;
+  request.first = first;
+  request.last = last;
+  request.truth = truth;
+  const auto start = Clock::now();
+  const ReconstructResult result = RunReconstruction(request);
+  Row row{snippet, ModeName(mode), "PSNR dB (frame " + std::to_string(truth) + ")",
+          result.truth.baseline_psnr, result.truth.psnr,
+          mode == Mode::kInterpolate ? "blend" : "copy",
+          result.reconstruction.video.num_frames(), SecondsSince(start)};
+  return row;
+}
+
+// eslnet cups: no sharp truth. The mean of the latent frames must reproduce the blurred input,
+// and the latent frames must be sharper than it (variance of the Laplacian).
+std::vector<Row> RunCupsDeblur(int frame) {
+  ReconstructRequest request;
+  request.data_path = (fs::path(FLAGS_data) / "eslnet_cups_blur").string();
+  request.mode = Mode::kDeblur;
+  request.first = frame;
+  const auto start = Clock::now();
+  const ReconstructResult result = RunReconstruction(request);
+  const double wall_s = SecondsSince(start);
+  const Video& latent = result.reconstruction.video;
+  const Image blurred = result.baseline.frame(0);
+  Image mean = Image::Zero(latent.height(), latent.width());
+  double sharpness = 0.0;
+  for (int t = 0; t < latent.num_frames(); ++t) {
+    mean += latent.frame(t);
+    sharpness += LaplacianVariance(latent.frame(t));
+  }
+  mean /= latent.num_frames();
+  sharpness /= latent.num_frames();
+  const std::string name = "eslnet_cups_blur #" + std::to_string(frame);
+  return {
+      Row{name, "deblur", "mean of latent vs input, PSNR dB", 0.0, Psnr(mean, blurred), "-",
+          latent.num_frames(), wall_s},
+      Row{name, "deblur", "Laplacian variance ×1e3", 1e3 * LaplacianVariance(blurred),
+          1e3 * sharpness, "input", latent.num_frames(), wall_s},
+  };
+}
+
+struct Clip {
+  Video frames;
+  EventStream events;
+};
+
+Clip LoadClip(const std::string& name, int num_frames) {
+  const fs::path folder = fs::path(FLAGS_data) / name;
+  const std::vector<FrameInfo> list = ReadFrameList((folder / "images.txt").string());
+  Clip clip;
+  for (int i = 0; i < num_frames && i < static_cast<int>(list.size()); ++i) {
+    clip.frames.AppendFrame(ReadGreyImage((folder / list[i].path).string()), list[i].t_ns);
+  }
+  clip.events = SimulateEvents(clip.frames, SimulatorOptions());
+  return clip;
+}
+
+TimedFrame Sharp(const Video& frames, int t) {
+  return TimedFrame{frames.frame(t), frames.timestamp_ns(t), frames.timestamp_ns(t),
+                    "frame " + std::to_string(t)};
+}
+
+Row RunClipInterpolation(const std::string& name, const Clip& clip) {
+  const auto start = Clock::now();
+  const Scene scene =
+      MakeInterpolationScene(Sharp(clip.frames, 0), Sharp(clip.frames, 4), clip.events,
+                             BinningOptions());
+  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
+  const int index = result.video.NearestFrame(clip.frames.timestamp_ns(2));
+  const Image& truth = clip.frames.frame(2);
+  return Row{name, "interpolate", "PSNR dB (frame 2 from 0, 4)",
+             Psnr(InitializeLatentVideo(scene).frame(index), truth),
+             Psnr(result.video.frame(index), truth), "blend", result.video.num_frames(),
+             SecondsSince(start)};
+}
+
+Row RunClipDeblur(const std::string& name, const Clip& clip) {
+  constexpr int kBlurFrames = 8;
+  const auto start = Clock::now();
+  TimedFrame blurred{Image::Zero(clip.frames.height(), clip.frames.width()),
+                     clip.frames.timestamp_ns(0), clip.frames.timestamp_ns(kBlurFrames - 1),
+                     "mean of frames 0-7"};
+  for (int t = 0; t < kBlurFrames; ++t) blurred.image += clip.frames.frame(t);
+  blurred.image /= kBlurFrames;
+  const Scene scene = MakeDeblurScene(blurred, clip.events, BinningOptions());
+  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
+  double blurred_psnr = 0.0, evfs_psnr = 0.0;
+  for (int t = 0; t < kBlurFrames; ++t) {
+    const int index = result.video.NearestFrame(clip.frames.timestamp_ns(t));
+    blurred_psnr += Psnr(blurred.image, clip.frames.frame(t)) / kBlurFrames;
+    evfs_psnr += Psnr(result.video.frame(index), clip.frames.frame(t)) / kBlurFrames;
+  }
+  return Row{name, "deblur", "PSNR dB (mean over frames 0-7)", blurred_psnr, evfs_psnr,
+             "blurred", result.video.num_frames(), SecondsSince(start)};
+}
+
+int Main() {
+  if (FLAGS_data.empty() || !fs::is_directory(FLAGS_data)) {
+    std::fprintf(stderr, "no data folder '%s': pass --data=../shared/data\n", FLAGS_data.c_str());
+    return 2;
+  }
+  std::printf("| data | case | metric | baseline | evfs | gain | latent frames | wall |\n"
+              "|---|---|---|---|---|---|---|---|\n");
+  std::vector<Row> rows;
+  const auto add = [&rows](const Row& row) {
+    PrintRow(row);
+    rows.push_back(row);
+  };
+  if (Wants("slider")) add(RunTruthCase("slider_depth_70_71", Mode::kPredict, 0, 1, 1));
+  if (Wants("shapes")) add(RunTruthCase("shapes_rotation_13_20", Mode::kInterpolate, 2, 4, 3));
+  if (Wants("cups")) {
+    for (const Row& row : RunCupsDeblur(1)) add(row);
+  }
+  if (Wants("clips")) {
+    for (const std::string& name : Split(FLAGS_clips)) {
+      const Clip clip = LoadClip(name, 8);
+      add(RunClipInterpolation(name, clip));
+      add(RunClipDeblur(name, clip));
+    }
+  }
+  if (!FLAGS_csv.empty()) {
+    std::ofstream csv(FLAGS_csv);
+    csv << "data,case,metric,baseline_name,baseline,evfs,latent_frames,wall_s\n";
+    for (const Row& row : rows) {
+      csv << row.data << "," << row.method_case << ",\"" << row.metric << "\","
+          << row.baseline_name << "," << row.baseline << "," << row.evfs << ","
+          << row.latent_frames << "," << row.wall_s << "\n";
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace evfs
+
+int main(int argc, char** argv) {
+  gflags::SetUsageMessage("reconstruction quality and time on the shared data, default options");
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  google::InitGoogleLogging(argv[0]);
+  try {
+    return evfs::Main();
+  } catch (const evfs::Error& error) {
+    std::fprintf(stderr, "reconstruction_benchmark: %s\n", error.what());
+    return 2;
+  }
+}
