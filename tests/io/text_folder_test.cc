@@ -74,9 +74,23 @@ TEST(TextFolderDataSourceTest, MissingPiecesAreInputErrors) {
   testing::ExpectInputError([&] { TextFolderDataSource s(no_first); },
                             InputError::Kind::kMissingFile, "images/a.png", 0);
 
+  // Frames without events.txt: a frames-only recording (a ground-truth clip to simulate
+  // from). It opens; reading its events is the error, and names the file.
   const std::string no_events = MakeFolder("folder_missing_events", "");
   std::filesystem::remove(no_events + "/events.txt");
-  testing::ExpectInputError([&] { TextFolderDataSource s(no_events); },
+  const TextFolderDataSource frames_only(no_events);
+  EXPECT_FALSE(frames_only.has_events());
+  EXPECT_EQ(frames_only.Summarize().count, 0);
+  EXPECT_EQ(frames_only.frames().size(), 2u);
+  testing::ExpectInputError([&] { frames_only.ReadEvents(0, 1000); },
+                            InputError::Kind::kMissingFile, "events.txt", 0);
+  testing::ExpectInputError([&] { frames_only.ReadAllEvents(); }, InputError::Kind::kMissingFile,
+                            "events.txt", 0);
+
+  // Neither events nor frames: nothing to open.
+  const std::string empty = testing::ScratchDir("folder_empty");
+  testing::WriteFile(empty + "/images.txt", "# nothing\n");
+  testing::ExpectInputError([&] { TextFolderDataSource s(empty); },
                             InputError::Kind::kMissingFile, "events.txt", 0);
 
   testing::ExpectInputError([&] { TextFolderDataSource s(no_events + "/nope"); },
