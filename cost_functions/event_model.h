@@ -65,13 +65,28 @@ inline double IntensityTransformDerivative(double intensity, const EventModelPar
   return intensity > 0.0 ? 1.0 / (intensity + params.log_offset) : 0.0;
 }
 
-/// Predicted event value of one latent step: tanh(alpha * (g(after) - g(before))).
+/// Predicted event value of one latent step: c tanh(alpha (g(after) - g(before)) / c).
+///
+/// c = 1 is the paper's model (Eq. 2): a collision-binned step holds at most one event. A step
+/// of a stacked event frame (Binning 2) holds a signed count, which tanh cannot reach; the
+/// paper sums several sub-steps instead, at the price of more latent frames. With c = the
+/// count per step the curve keeps the paper's slope alpha at 0 and saturates at the count, so
+/// one latent step can explain it (SaturationForCount).
 template <typename T>
 T PredictedEvent(const T& intensity_before, const T& intensity_after,
-                 const EventModelParams& params) {
+                 const EventModelParams& params, double saturation = 1.0) {
   using std::tanh;
-  return tanh(params.alpha * (IntensityTransform(intensity_after, params) -
-                              IntensityTransform(intensity_before, params)));
+  return saturation * tanh(params.alpha *
+                           (IntensityTransform(intensity_after, params) -
+                            IntensityTransform(intensity_before, params)) /
+                           saturation);
+}
+
+/// c of PredictedEvent for an event frame holding `event_value` over `num_steps` steps: at
+/// least 1 (the paper's model for collision frames and zero counts), else the count per step.
+inline double SaturationForCount(double event_value, int num_steps) {
+  const double per_step = (event_value < 0.0 ? -event_value : event_value) / num_steps;
+  return per_step > 1.0 ? per_step : 1.0;
 }
 
 }  // namespace evfs

@@ -1,9 +1,10 @@
-// r = E_k(p) - sum_{s=a}^{b-1} tanh(alpha * (g(H_{s+1}(p)) - g(H_s(p))))   (paper Eq. 2 with g
-// linear; Eq. 1 with g = log(x + b))
+// r = E_k(p) - sum_{s=a}^{b-1} c tanh(alpha * (g(H_{s+1}(p)) - g(H_s(p))) / c)
+//     (paper Eq. 2 with g linear; Eq. 1 with g = log(x + b); c = 1 in the paper)
 //
 // One residual per event-frame pixel. Collision binning (paper §3.3, Binning 1) gives event
-// frames spanning one latent step (b = a + 1) and values in {-1, 0, 1}; stacked binning
-// (Binning 2) spans several steps and holds signed counts, modelled as the sum of the steps.
+// frames spanning one latent step (b = a + 1) and values in {-1, 0, 1}, and c = 1; stacked
+// binning (Binning 2) spans one or more steps and holds signed counts, modelled as the sum of
+// the steps, each saturating at c = max(1, |E| / steps) (PredictedEvent).
 #ifndef EVFS_COST_FUNCTIONS_EVENT_RESIDUAL_H_
 #define EVFS_COST_FUNCTIONS_EVENT_RESIDUAL_H_
 
@@ -22,7 +23,10 @@ namespace evfs {
 struct EventResidual {
   /// `event_value` is E_k(p); `num_steps` is b - a (at least 1).
   EventResidual(double event_value, int num_steps, const EventModelParams& params)
-      : event_value(event_value), num_steps(num_steps), params(params) {
+      : event_value(event_value),
+        num_steps(num_steps),
+        params(params),
+        saturation(SaturationForCount(event_value, num_steps)) {
     CHECK_GE(num_steps, 1);
     CheckEventModelParams(params);
   }
@@ -31,7 +35,8 @@ struct EventResidual {
   bool operator()(T const* const* intensities, T* residual) const {
     T predicted_event(0.0);
     for (int s = 0; s < num_steps; ++s) {
-      predicted_event += PredictedEvent(intensities[s][0], intensities[s + 1][0], params);
+      predicted_event +=
+          PredictedEvent(intensities[s][0], intensities[s + 1][0], params, saturation);
     }
     residual[0] = T(event_value) - predicted_event;
     return true;
@@ -46,24 +51,29 @@ struct EventResidual {
   const double event_value;
   const int num_steps;
   const EventModelParams params;
+  const double saturation;  // c, from the count per step
 };
 
 /// EventResidual for one latent step with a fixed parameter layout (H_a, H_{a+1}), so that Ceres
 /// can use its fixed-size autodiff.
 struct OneStepEventResidual {
   OneStepEventResidual(double event_value, const EventModelParams& params)
-      : event_value(event_value), params(params) {
+      : event_value(event_value),
+        params(params),
+        saturation(SaturationForCount(event_value, 1)) {
     CheckEventModelParams(params);
   }
 
   template <typename T>
   bool operator()(const T* intensity_before, const T* intensity_after, T* residual) const {
-    residual[0] = T(event_value) - PredictedEvent(intensity_before[0], intensity_after[0], params);
+    residual[0] = T(event_value) -
+                  PredictedEvent(intensity_before[0], intensity_after[0], params, saturation);
     return true;
   }
 
   const double event_value;
   const EventModelParams params;
+  const double saturation;  // c, from the count
 };
 
 inline ceres::CostFunction* EventResidual::Create(double event_value, int num_steps,
@@ -78,12 +88,14 @@ inline ceres::CostFunction* EventResidual::Create(double event_value, int num_st
 }
 
 /// OneStepEventResidual with its Jacobians written by hand, for the micro-benchmarks that
-/// compare autodiff against analytic derivatives. With u = tanh(alpha (g(H_1) - g(H_0))):
+/// compare autodiff against analytic derivatives. With u = tanh(alpha (g(H_1) - g(H_0)) / c):
 ///   dr/dH_0 =  alpha (1 - u^2) g'(H_0),   dr/dH_1 = -alpha (1 - u^2) g'(H_1).
 class EventResidualAnalytic : public ceres::SizedCostFunction<1, 1, 1> {
  public:
   EventResidualAnalytic(double event_value, const EventModelParams& params)
-      : event_value_(event_value), params_(params) {
+      : event_value_(event_value),
+        params_(params),
+        saturation_(SaturationForCount(event_value, 1)) {
     CheckEventModelParams(params);
   }
 
@@ -91,10 +103,12 @@ class EventResidualAnalytic : public ceres::SizedCostFunction<1, 1, 1> {
                 double** jacobians) const override {
     const double intensity_before = parameters[0][0];
     const double intensity_after = parameters[1][0];
-    const double predicted_event = PredictedEvent(intensity_before, intensity_after, params_);
+    const double predicted_event =
+        PredictedEvent(intensity_before, intensity_after, params_, saturation_);
     residuals[0] = event_value_ - predicted_event;
     if (jacobians == nullptr) return true;
-    const double slope = params_.alpha * (1.0 - predicted_event * predicted_event);
+    const double u = predicted_event / saturation_;
+    const double slope = params_.alpha * (1.0 - u * u);
     if (jacobians[0] != nullptr) {
       jacobians[0][0] = slope * IntensityTransformDerivative(intensity_before, params_);
     }
@@ -107,6 +121,7 @@ class EventResidualAnalytic : public ceres::SizedCostFunction<1, 1, 1> {
  private:
   const double event_value_;
   const EventModelParams params_;
+  const double saturation_;
 };
 
 }  // namespace evfs

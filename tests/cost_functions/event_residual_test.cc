@@ -69,6 +69,27 @@ TEST(EventResidual, NominalMultiStepSumsTheSteps) {
   EXPECT_NEAR(evaluation.jacobians[1][0], -slope_step0 + slope_step1, kNominalTolerance);
 }
 
+TEST(EventResidual, NominalCountSaturatesAtTheCountPerStep) {
+  // A stacked frame with 3 events over one step: 3 - 3 tanh(alpha (0.3 - 0.2) / 3), slope alpha
+  // at zero change as for a single event.
+  const std::unique_ptr<ceres::CostFunction> cost(EventResidual::Create(3.0, 1, LinearParams(5.0)));
+  const test::Evaluation evaluation = test::Evaluate(*cost, {0.2, 0.3});
+  ASSERT_TRUE(evaluation.return_value);
+  const double u = std::tanh(0.5 / 3.0);
+  EXPECT_NEAR(evaluation.residuals[0], 3.0 - 3.0 * u, kNominalTolerance);
+  EXPECT_NEAR(evaluation.jacobians[1][0], -5.0 * (1.0 - u * u), kNominalTolerance);
+  // Over two steps, -4 events saturate each step at 2.
+  const std::unique_ptr<ceres::CostFunction> two_steps(
+      EventResidual::Create(-4.0, 2, LinearParams(5.0)));
+  const test::Evaluation stacked = test::Evaluate(*two_steps, {0.5, 0.4, 0.2});
+  EXPECT_NEAR(stacked.residuals[0],
+              -4.0 - 2.0 * (std::tanh(-0.5 / 2.0) + std::tanh(-1.0 / 2.0)), kNominalTolerance);
+  // Counts of at most one per step keep the paper's model.
+  EXPECT_DOUBLE_EQ(SaturationForCount(-1.0, 1), 1.0);
+  EXPECT_DOUBLE_EQ(SaturationForCount(2.0, 4), 1.0);
+  EXPECT_DOUBLE_EQ(SaturationForCount(-6.0, 2), 3.0);
+}
+
 TEST(EventResidual, CreateUsesFixedSizeAutoDiffForOneStep) {
   const std::unique_ptr<ceres::CostFunction> one_step(
       EventResidual::Create(1.0, 1, LinearParams(5.0)));
@@ -87,7 +108,7 @@ TEST(EventResidual, GradientCheck) {
       SCOPED_TRACE(::testing::Message() << "log model: " << (params.model == EventModel::kLog)
                                         << ", steps: " << num_steps);
       const std::unique_ptr<ceres::CostFunction> cost(
-          EventResidual::Create(1.0, num_steps, params));
+          EventResidual::Create(num_steps == 2 ? -5.0 : 1.0, num_steps, params));
       for (int i = 0; i < test::kRandomPoints; ++i) {
         // Away from 0, where the log model's guard has a kink.
         test::ExpectGradientCheckPasses(*cost,
@@ -134,7 +155,8 @@ TEST(EventResidual, LargeAlphaSaturatesWithFiniteJacobians) {
 
 TEST(EventResidualAnalytic, MatchesAutoDiff) {
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> event_value(-1.0, 1.0);
+  // Beyond ±1 too: stacked counts saturate at the count.
+  std::uniform_real_distribution<double> event_value(-4.0, 4.0);
   for (const EventModelParams& params : {LinearParams(5.0), LogParams(12.0)}) {
     SCOPED_TRACE(params.model == EventModel::kLog ? "log" : "linear");
     for (int i = 0; i < test::kRandomPoints; ++i) {
