@@ -67,10 +67,21 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// PSNR rows compare by difference, other rows (sharpness) by ratio; rows without a baseline
+// (baseline_name "-") by neither.
 void PrintRow(const Row& row) {
-  std::printf("| %s | %s | %s | %s %.2f | %.2f | %+.2f | %d | %.1f s |\n", row.data.c_str(),
-              row.method_case.c_str(), row.metric.c_str(), row.baseline_name.c_str(),
-              row.baseline, row.evfs, row.evfs - row.baseline, row.latent_frames, row.wall_s);
+  char baseline[64] = "-", gain[32] = "-";
+  if (row.baseline_name != "-") {
+    std::snprintf(baseline, sizeof(baseline), "%s %.2f", row.baseline_name.c_str(), row.baseline);
+    if (row.metric.find("PSNR") != std::string::npos) {
+      std::snprintf(gain, sizeof(gain), "%+.2f dB", row.evfs - row.baseline);
+    } else {
+      std::snprintf(gain, sizeof(gain), "x%.2f", row.evfs / row.baseline);
+    }
+  }
+  std::printf("| %s | %s | %s | %s | %.2f | %s | %d | %.1f s |\n", row.data.c_str(),
+              row.method_case.c_str(), row.metric.c_str(), baseline, row.evfs, gain,
+              row.latent_frames, row.wall_s);
   std::fflush(stdout);
 }
 
@@ -113,9 +124,9 @@ std::vector<Row> RunCupsDeblur(int frame) {
   sharpness /= latent.num_frames();
   const std::string name = "eslnet_cups_blur #" + std::to_string(frame);
   return {
-      Row{name, "deblur", "mean of latent vs input, PSNR dB", 0.0, Psnr(mean, blurred), "-",
+      Row{name, "deblur", "mean of latent frames vs input, PSNR dB", 0.0, Psnr(mean, blurred), "-",
           latent.num_frames(), wall_s},
-      Row{name, "deblur", "Laplacian variance ×1e3", 1e3 * LaplacianVariance(blurred),
+      Row{name, "deblur", "variance of Laplacian ×1e3 (mean of latent)", 1e3 * LaplacianVariance(blurred),
           1e3 * sharpness, "input", latent.num_frames(), wall_s},
   };
 }
