@@ -87,7 +87,8 @@ inline std::string ReadFile(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
 }
 
-/// Runs `body`, which must throw InputError; returns the error (a placeholder after a failure).
+/// Runs `body`, which must throw InputError, and returns the error. When it does not throw, the
+/// test fails and a sentinel error naming "<none thrown>" is returned so that callers can go on.
 template <typename Body>
 InputError CatchInputError(Body&& body) {
   try {
