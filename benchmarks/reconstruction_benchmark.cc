@@ -32,6 +32,11 @@ DEFINE_string(clips,
               "adobe240_IMG_0036",
               "Ground-truth clips for the simulated-event cases.");
 DEFINE_string(csv, "", "Also write the rows as CSV to this file.");
+// Overrides of the defaults, for exploring them; the published figures use none.
+DEFINE_double(alpha, evfs::ObjectiveOptions().event_model.alpha, "alpha; 0 derives it.");
+DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight, "lambda_xy.");
+DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
+             "auto binning's voxel budget.");
 
 namespace evfs {
 namespace {
@@ -61,6 +66,19 @@ bool Wants(const std::string& name) {
     if (c == name) return true;
   }
   return false;
+}
+
+ReconstructionOptions Options() {
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = FLAGS_alpha;
+  options.objective.spatial_tv_weight = FLAGS_spatial_tv_weight;
+  return options;
+}
+
+BinningOptions Binning() {
+  BinningOptions binning;
+  binning.max_latent_voxels = FLAGS_max_latent_voxels;
+  return binning;
 }
 
 double SecondsSince(Clock::time_point start) {
@@ -93,6 +111,8 @@ Row RunTruthCase(const std::string& snippet, Mode mode, int first, int last, int
   request.first = first;
   request.last = last;
   request.truth = truth;
+  request.options = Options();
+  request.binning = Binning();
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   Row row{snippet, ModeName(mode), "PSNR dB (frame " + std::to_string(truth) + ")",
@@ -109,6 +129,8 @@ std::vector<Row> RunCupsDeblur(int frame) {
   request.data_path = (fs::path(FLAGS_data) / "eslnet_cups_blur").string();
   request.mode = Mode::kDeblur;
   request.first = frame;
+  request.options = Options();
+  request.binning = Binning();
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   const double wall_s = SecondsSince(start);
@@ -155,9 +177,8 @@ TimedFrame Sharp(const Video& frames, int t) {
 Row RunClipInterpolation(const std::string& name, const Clip& clip) {
   const auto start = Clock::now();
   const Scene scene =
-      MakeInterpolationScene(Sharp(clip.frames, 0), Sharp(clip.frames, 4), clip.events,
-                             BinningOptions());
-  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
+      MakeInterpolationScene(Sharp(clip.frames, 0), Sharp(clip.frames, 4), clip.events, Binning());
+  const Reconstruction result = Reconstruct(scene, Options());
   const int index = result.video.NearestFrame(clip.frames.timestamp_ns(2));
   const Image& truth = clip.frames.frame(2);
   return Row{name, "interpolate", "PSNR dB (frame 2 from 0, 4)",
@@ -174,8 +195,8 @@ Row RunClipDeblur(const std::string& name, const Clip& clip) {
                      "mean of frames 0-7"};
   for (int t = 0; t < kBlurFrames; ++t) blurred.image += clip.frames.frame(t);
   blurred.image /= kBlurFrames;
-  const Scene scene = MakeDeblurScene(blurred, clip.events, BinningOptions());
-  const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
+  const Scene scene = MakeDeblurScene(blurred, clip.events, Binning());
+  const Reconstruction result = Reconstruct(scene, Options());
   double blurred_psnr = 0.0, evfs_psnr = 0.0;
   for (int t = 0; t < kBlurFrames; ++t) {
     const int index = result.video.NearestFrame(clip.frames.timestamp_ns(t));
