@@ -1,8 +1,9 @@
 #include "core/video.h"
 
 #include <algorithm>
-#include <cstdlib>
+#include <string>
 
+#include "core/error.h"
 #include "core/time.h"
 
 namespace evfs {
@@ -20,8 +21,11 @@ void Video::AppendFrame(const Image& image, int64_t timestamp_ns) {
     height_ = static_cast<int>(image.rows());
     width_ = static_cast<int>(image.cols());
   }
-  // A size mismatch here is a programming error: readers validate sizes against the file.
-  if (image.rows() != height_ || image.cols() != width_) std::abort();
+  if (image.rows() != height_ || image.cols() != width_) {
+    throw InvalidArgumentError("cannot append a " + std::to_string(image.cols()) + "x" +
+                               std::to_string(image.rows()) + " frame to a " +
+                               std::to_string(width_) + "x" + std::to_string(height_) + " video");
+  }
   data_.insert(data_.end(), image.data(), image.data() + image.size());
   timestamps_ns_.push_back(timestamp_ns);
 }

@@ -43,7 +43,8 @@ class Video {
   void set_timestamp_ns(int t, int64_t t_ns) { timestamps_ns_[t] = t_ns; }
   const std::vector<int64_t>& timestamps_ns() const { return timestamps_ns_; }
 
-  /// Appends a frame of this video's size (the first frame sets the size).
+  /// Appends a frame of this video's size (the first frame sets the size); throws
+  /// InvalidArgumentError for a frame of another size.
   void AppendFrame(const Image& image, int64_t timestamp_ns);
 
   /// Index of the frame whose timestamp is nearest to `t_ns` (ties go to the earlier frame).

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
+
 namespace evfs {
 namespace {
 
@@ -23,6 +25,8 @@ TEST(Video, AppendFrameSetsSizeAndTimestamp) {
   EXPECT_EQ(video.width(), 3);
   EXPECT_EQ(video.timestamp_ns(1), 300);
   EXPECT_DOUBLE_EQ(video.timestamp_s(1), 3e-7);
+  EXPECT_THROW(video.AppendFrame(Image::Constant(3, 2, 0.5), 400), InvalidArgumentError);
+  EXPECT_EQ(video.num_frames(), 2);
 }
 
 TEST(Video, NearestFrameAndInterpolation) {
