@@ -5,7 +5,6 @@
 #include <fstream>
 #include <vector>
 
-#include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
 #include "events/scene_synthesizer.h"
