@@ -2,7 +2,9 @@
 // the mean over its exposure, paper §3.2 deblur)
 //
 // One residual per observed frame pixel. A sharp frame (a = b) takes one latent voxel; a
-// motion-blurred frame takes the n voxels of pixel p over its exposure a..b.
+// motion-blurred frame takes the n voxels of pixel p over its exposure a..b. When runs of those
+// voxels share one value (merged segments, solver/latent_layout.h), each run is one parameter
+// block counted with its length: r = F - sum_i c_i x_i / sum_i c_i.
 #ifndef EVFS_COST_FUNCTIONS_FRAME_RESIDUAL_H_
 #define EVFS_COST_FUNCTIONS_FRAME_RESIDUAL_H_
 
@@ -11,23 +13,37 @@
 #include <ceres/sized_cost_function.h>
 #include <glog/logging.h>
 
+#include <utility>
+#include <vector>
+
 #include "cost_functions/scalar_parameter_blocks.h"
 
 namespace evfs {
 
 /// Residual of one frame pixel against the mean of the latent intensities over its exposure.
-/// Parameter blocks: H_a(p) .. H_b(p), each of size 1. Residual: 1.
+/// Parameter blocks: one per run of latent frames, each of size 1. Residual: 1.
 struct FrameResidual {
-  /// `observed_intensity` is F_j(p); `num_latent_frames` is n = b - a + 1 (at least 1).
+  /// `observed_intensity` is F_j(p); `num_latent_frames` is n = b - a + 1 (at least 1), one
+  /// parameter block per latent frame.
   FrameResidual(double observed_intensity, int num_latent_frames)
-      : observed_intensity(observed_intensity), num_latent_frames(num_latent_frames) {
-    CHECK_GE(num_latent_frames, 1);
+      : FrameResidual(observed_intensity, std::vector<int>(num_latent_frames, 1)) {}
+
+  /// One parameter block per run; `run_lengths[i]` latent frames share block i's value.
+  FrameResidual(double observed_intensity, std::vector<int> run_lengths)
+      : observed_intensity(observed_intensity), run_lengths(std::move(run_lengths)) {
+    CHECK(!this->run_lengths.empty());
+    for (const int length : this->run_lengths) {
+      CHECK_GE(length, 1);
+      num_latent_frames += length;
+    }
   }
 
   template <typename T>
   bool operator()(T const* const* intensities, T* residual) const {
     T intensity_sum(0.0);
-    for (int t = 0; t < num_latent_frames; ++t) intensity_sum += intensities[t][0];
+    for (size_t i = 0; i < run_lengths.size(); ++i) {
+      intensity_sum += static_cast<double>(run_lengths[i]) * intensities[i][0];
+    }
     residual[0] = T(observed_intensity) - intensity_sum / static_cast<double>(num_latent_frames);
     return true;
   }
@@ -35,10 +51,15 @@ struct FrameResidual {
   /// A fixed-size AutoDiffCostFunction<SharpFrameResidual, 1, 1> when `num_latent_frames` is 1
   /// (a sharp frame, by far the most common), else a DynamicAutoDiffCostFunction with
   /// `num_latent_frames` parameter blocks of size 1.
-  static ceres::CostFunction* Create(double observed_intensity, int num_latent_frames);
+  static ceres::CostFunction* Create(double observed_intensity, int num_latent_frames) {
+    return Create(observed_intensity, std::vector<int>(num_latent_frames, 1));
+  }
+  /// The same over runs: fixed-size for a single run, else one block per run.
+  static ceres::CostFunction* Create(double observed_intensity, std::vector<int> run_lengths);
 
   const double observed_intensity;
-  const int num_latent_frames;
+  const std::vector<int> run_lengths;
+  int num_latent_frames = 0;  // n: the sum of the run lengths
 };
 
 /// FrameResidual for a sharp frame (n = 1) with a fixed parameter layout, so that Ceres can use
@@ -56,14 +77,16 @@ struct SharpFrameResidual {
 };
 
 inline ceres::CostFunction* FrameResidual::Create(double observed_intensity,
-                                                  int num_latent_frames) {
-  CHECK_GE(num_latent_frames, 1);
-  if (num_latent_frames == 1) {
+                                                  std::vector<int> run_lengths) {
+  CHECK(!run_lengths.empty());
+  if (run_lengths.size() == 1) {
+    // The mean of one run is its value, whatever its length.
     return new ceres::AutoDiffCostFunction<SharpFrameResidual, 1, 1>(
         new SharpFrameResidual(observed_intensity));
   }
+  const int num_blocks = static_cast<int>(run_lengths.size());
   return CreateDynamicAutoDiffOverScalarBlocks(
-      new FrameResidual(observed_intensity, num_latent_frames), num_latent_frames,
+      new FrameResidual(observed_intensity, std::move(run_lengths)), num_blocks,
       /*num_residuals=*/1);
 }
 

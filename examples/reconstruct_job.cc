@@ -234,9 +234,11 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json.Field("active", summary.problem.active_pixels);
   json.Field("skipped", summary.problem.skipped_pixels);
   json.Field("activity_radius_px", options.activity_radius_px);
+  json.Field("merge_quiet_steps", options.merge_quiet_steps);
   json.EndObject();
   json.Key("problem").BeginObject();
   json.Field("parameter_blocks", summary.problem.parameter_blocks);
+  json.Field("unknowns", summary.problem.variable_parameter_blocks);
   json.Field("residual_blocks", summary.problem.residual_blocks());
   json.Field("frame_residuals", summary.problem.frame_residuals);
   json.Field("event_residuals", summary.problem.event_residuals);

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <functional>
+#include <initializer_list>
 #include <tuple>
+#include <utility>
 
 #include "core/error.h"
-#include "solver/activity_mask.h"
 #include "cost_functions/difference_residual.h"
 #include "cost_functions/event_residual.h"
 #include "cost_functions/frame_residual.h"
@@ -15,9 +16,10 @@
 namespace evfs {
 namespace {
 
-// Cost functions depend only on (family, observed value, span length), and observations take
-// few distinct values (events are {-1, 0, 1} or small counts, frames 8- or 16-bit levels), so one
-// cost function per key serves every residual block that shares it.
+// Cost functions depend only on (family, observed value, shape), and observations take few
+// distinct values (events are {-1, 0, 1} or small counts, frames 8- or 16-bit levels), so one
+// cost function per key serves every residual block that shares it. The shape is the number of
+// steps of an event frame, or the run lengths of a frame observation's segments.
 class CostFunctionCache {
  public:
   enum class Family { kFrame, kEvent, kSpatialTv, kTemporalTv };
@@ -25,20 +27,42 @@ class CostFunctionCache {
   explicit CostFunctionCache(std::vector<std::unique_ptr<ceres::CostFunction>>* owned)
       : owned_(owned) {}
 
-  ceres::CostFunction* Get(Family family, double value, int span,
+  ceres::CostFunction* Get(Family family, double value, const std::vector<int>& shape,
                            const std::function<ceres::CostFunction*()>& create) {
-    const Key key(family, value, span);
+    Key key(family, value, shape);
     const auto it = cache_.find(key);
     if (it != cache_.end()) return it->second;
     owned_->emplace_back(create());
+    cache_.emplace(std::move(key), owned_->back().get());
+    return owned_->back().get();
+  }
+
+ private:
+  using Key = std::tuple<Family, double, std::vector<int>>;
+  std::vector<std::unique_ptr<ceres::CostFunction>>* owned_;
+  std::map<Key, ceres::CostFunction*> cache_;
+};
+
+// One loss per term family and multiplicity: a residual standing for m identical terms (a spatial
+// TV pair that keeps its segments over m latent frames) is weighted m times.
+class LossCache {
+ public:
+  LossCache(std::vector<std::unique_ptr<ceres::LossFunction>>* owned, double smoothing_scale)
+      : owned_(owned), smoothing_scale_(smoothing_scale) {}
+
+  ceres::LossFunction* Get(double weight, int multiplicity) {
+    const std::pair<double, int> key(weight, multiplicity);
+    const auto it = cache_.find(key);
+    if (it != cache_.end()) return it->second;
+    owned_->emplace_back(CreateWeightedL1Loss(weight * multiplicity, smoothing_scale_));
     cache_.emplace(key, owned_->back().get());
     return owned_->back().get();
   }
 
  private:
-  using Key = std::tuple<Family, double, int>;
-  std::vector<std::unique_ptr<ceres::CostFunction>>* owned_;
-  std::map<Key, ceres::CostFunction*> cache_;
+  std::vector<std::unique_ptr<ceres::LossFunction>>* owned_;
+  const double smoothing_scale_;
+  std::map<std::pair<double, int>, ceres::LossFunction*> cache_;
 };
 
 }  // namespace
@@ -57,6 +81,11 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   const int64_t pixels = latent->pixels_per_frame();
 
   auto built = std::make_unique<BuiltProblem>();
+  const ActivityMask mask(scene_.events, options_.activity_radius_px);
+  built->layout_ = std::make_unique<LatentLayout>(scene_, mask, *latent, options_.merge_quiet_steps);
+  const LatentLayout& layout = *built->layout_;
+  layout.ProjectOnto(latent);
+
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -68,47 +97,51 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   ceres::Problem& problem = *built->problem_;
   ProblemStatistics& statistics = built->statistics_;
   CostFunctionCache cache(&built->cost_functions_);
+  LossCache losses(&built->losses_, objective.smoothing_scale);
 
-  const ActivityMask mask(scene_.events, options_.activity_radius_px);
-  for (int64_t p = 0; p < pixels; ++p) {
-    if (!mask.in_problem(p)) continue;
-    for (int t = 0; t < num_latent; ++t) {
-      double* voxel = latent->frame_data(t) + p;
-      problem.AddParameterBlock(voxel, 1);
-      if (!mask.active(p)) {
-        problem.SetParameterBlockConstant(voxel);
-      } else if (options_.bound_intensities) {
-        problem.SetParameterLowerBound(voxel, 0, 0.0);
-        problem.SetParameterUpperBound(voxel, 0, 1.0);
-      }
-      ++statistics.parameter_blocks;
+  for (int64_t s = 0; s < layout.num_segments(); ++s) {
+    double* value = layout.value(s, latent);
+    problem.AddParameterBlock(value, 1);
+    if (layout.segment(s).constant) {
+      problem.SetParameterBlockConstant(value);
+    } else if (options_.bound_intensities) {
+      problem.SetParameterLowerBound(value, 0, 0.0);
+      problem.SetParameterUpperBound(value, 0, 1.0);
     }
   }
+  statistics.parameter_blocks = layout.num_segments();
+  statistics.variable_parameter_blocks = layout.num_variable_segments();
   statistics.active_pixels = mask.num_active();
   statistics.skipped_pixels = pixels - mask.num_active();
 
   // Each family's loss is weight / (h·w) times the smoothed |r| (ObjectiveOptions).
-  const auto make_loss = [&](double weight) {
-    built->losses_.emplace_back(
-        CreateWeightedL1Loss(weight / static_cast<double>(pixels), objective.smoothing_scale));
-    return built->losses_.back().get();
-  };
-  const auto voxel = [&](int t, int64_t p) { return latent->frame_data(t) + p; };
+  const double per_pixel = 1.0 / static_cast<double>(pixels);
+  const auto block = [&](int t, int64_t p) { return layout.value(layout.segment_at(t, p), latent); };
   using Family = CostFunctionCache::Family;
+  std::vector<double*> blocks;
+  std::vector<int> shape;
 
   if (objective.frame_weight > 0.0) {
-    ceres::LossFunction* loss = make_loss(objective.frame_weight);
-    std::vector<double*> blocks;
+    ceres::LossFunction* loss = losses.Get(objective.frame_weight * per_pixel, 1);
     for (const FrameObservation& frame : scene_.frames) {
-      const int span = frame.latent_last - frame.latent_first + 1;
-      blocks.resize(span);
       for (int64_t p = 0; p < pixels; ++p) {
         if (!mask.active(p)) continue;
+        // The exposure's voxels, one block per run of a segment.
+        blocks.clear();
+        shape.clear();
+        for (int t = frame.latent_first; t <= frame.latent_last; ++t) {
+          const int64_t s = layout.segment_at(t, p);
+          if (!blocks.empty() && layout.value(s, latent) == blocks.back()) {
+            ++shape.back();
+          } else {
+            blocks.push_back(layout.value(s, latent));
+            shape.push_back(1);
+          }
+        }
         const double value = frame.image.data()[p];
-        ceres::CostFunction* cost = cache.Get(Family::kFrame, value, span, [&] {
-          return FrameResidual::Create(value, span);
+        ceres::CostFunction* cost = cache.Get(Family::kFrame, value, shape, [&] {
+          return FrameResidual::Create(value, shape);
         });
-        for (int i = 0; i < span; ++i) blocks[i] = voxel(frame.latent_first + i, p);
         problem.AddResidualBlock(cost, loss, blocks);
         ++statistics.frame_residuals;
       }
@@ -116,24 +149,32 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   }
 
   if (objective.event_weight > 0.0) {
-    ceres::LossFunction* loss = make_loss(objective.event_weight);
-    std::vector<double*> blocks;
+    ceres::LossFunction* loss = losses.Get(objective.event_weight * per_pixel, 1);
     for (int k = 0; k < scene_.events.num_frames(); ++k) {
       const EventFrameSpan& span = scene_.events.span(k);
       const int steps = span.latent_last - span.latent_first;
       const float* values = scene_.events.frame_data(k);
-      blocks.resize(steps + 1);
       for (int64_t p = 0; p < pixels; ++p) {
         if (!mask.active(p)) continue;
+        // Over merged steps H does not change and the model predicts 0: a step contributes
+        // only where a segment starts. The layout starts one at every step of a frame that
+        // fired, so a frame is either all new segments or (quiet, value 0) none, residual 0.
+        int new_segments = 0;
+        for (int t = span.latent_first + 1; t <= span.latent_last; ++t) {
+          new_segments += layout.segment_at(t, p) != layout.segment_at(t - 1, p);
+        }
+        if (new_segments == 0) continue;
+        CHECK_EQ(new_segments, steps) << "an event frame's span is partly merged";
         const double value = values[p];
-        ceres::CostFunction* cost = cache.Get(Family::kEvent, value, steps, [&] {
+        ceres::CostFunction* cost = cache.Get(Family::kEvent, value, {steps}, [&] {
           return EventResidual::Create(value, steps, objective.event_model);
         });
         if (steps == 1) {
-          problem.AddResidualBlock(cost, loss, voxel(span.latent_first, p),
-                                   voxel(span.latent_last, p));
+          problem.AddResidualBlock(cost, loss, block(span.latent_first, p),
+                                   block(span.latent_last, p));
         } else {
-          for (int i = 0; i <= steps; ++i) blocks[i] = voxel(span.latent_first + i, p);
+          blocks.resize(steps + 1);
+          for (int i = 0; i <= steps; ++i) blocks[i] = block(span.latent_first + i, p);
           problem.AddResidualBlock(cost, loss, blocks);
         }
         ++statistics.event_residuals;
@@ -144,53 +185,61 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   if (objective.spatial_tv_weight > 0.0) {
     // A mean over latent frames: summed, smoothing a run of m frames would save m times the
     // TV while paying for only two temporal transitions, so finer binning would blur more.
-    ceres::LossFunction* loss = make_loss(objective.spatial_tv_weight / num_latent);
+    const double weight = objective.spatial_tv_weight * per_pixel / num_latent;
     // Anisotropic TV is two difference residuals; the other forms one three-point residual.
     const bool anisotropic = objective.spatial_tv == SpatialTv::kAnisotropic;
-    ceres::CostFunction* spatial_cost = cache.Get(Family::kSpatialTv, 0.0, 0, [&] {
+    ceres::CostFunction* spatial_cost = cache.Get(Family::kSpatialTv, 0.0, {}, [&] {
       if (anisotropic) return DifferenceResidual::Create();
       return objective.spatial_tv == SpatialTv::kIsotropic ? IsotropicTvResidual::Create()
                                                            : PaperTvResidual::Create();
     });
-    for (int t = 0; t < num_latent; ++t) {
-      for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) {
-          const int64_t p = static_cast<int64_t>(y) * width + x;
-          // A term is built when any pixel it touches is active; the others are then ring
-          // pixels, held constant.
-          const bool has_right = x + 1 < width, has_below = y + 1 < height;
-          const bool here = mask.active(p);
-          const bool right = has_right && mask.active(p + 1);
-          const bool below = has_below && mask.active(p + width);
-          if (anisotropic) {
-            if (has_right && (here || right)) {
-              problem.AddResidualBlock(spatial_cost, loss, voxel(t, p), voxel(t, p + 1));
-              ++statistics.spatial_tv_residuals;
-            }
-            if (has_below && (here || below)) {
-              problem.AddResidualBlock(spatial_cost, loss, voxel(t, p), voxel(t, p + width));
-              ++statistics.spatial_tv_residuals;
-            }
-          } else if (has_right && has_below && (here || right || below)) {
-            problem.AddResidualBlock(spatial_cost, loss, voxel(t, p), voxel(t, p + 1),
-                                     voxel(t, p + width));
-            ++statistics.spatial_tv_residuals;
-          }
+    // One residual per run of latent frames over which the pixels it touches keep their
+    // segments: the run's m identical terms, weighted m times.
+    const auto add_runs = [&](std::initializer_list<int64_t> touched) {
+      int run_first = 0;
+      for (int t = 1; t <= num_latent; ++t) {
+        bool same = t < num_latent;
+        for (const int64_t q : touched) {
+          same = same && layout.segment_at(t, q) == layout.segment_at(t - 1, q);
+        }
+        if (same) continue;
+        blocks.clear();
+        for (const int64_t q : touched) blocks.push_back(block(run_first, q));
+        problem.AddResidualBlock(spatial_cost, losses.Get(weight, t - run_first), blocks);
+        ++statistics.spatial_tv_residuals;
+        run_first = t;
+      }
+    };
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const int64_t p = static_cast<int64_t>(y) * width + x;
+        // A term is built when any pixel it touches is active; the others are then ring
+        // pixels, held constant.
+        const bool has_right = x + 1 < width, has_below = y + 1 < height;
+        const bool here = mask.active(p);
+        const bool right = has_right && mask.active(p + 1);
+        const bool below = has_below && mask.active(p + width);
+        if (anisotropic) {
+          if (has_right && (here || right)) add_runs({p, p + 1});
+          if (has_below && (here || below)) add_runs({p, p + width});
+        } else if (has_right && has_below && (here || right || below)) {
+          add_runs({p, p + 1, p + width});
         }
       }
     }
   }
 
   if (objective.temporal_tv_weight > 0.0 && num_latent > 1) {
-    ceres::LossFunction* loss = make_loss(objective.temporal_tv_weight);
+    // Σ_t |H_{t+1}(p) - H_t(p)| is the sum over the pixel's segment boundaries.
+    ceres::LossFunction* loss = losses.Get(objective.temporal_tv_weight * per_pixel, 1);
     ceres::CostFunction* difference =
-        cache.Get(Family::kTemporalTv, 0.0, 0, [] { return DifferenceResidual::Create(); });
-    for (int t = 0; t + 1 < num_latent; ++t) {
-      for (int64_t p = 0; p < pixels; ++p) {
-        if (!mask.active(p)) continue;
-        problem.AddResidualBlock(difference, loss, voxel(t, p), voxel(t + 1, p));
-        ++statistics.temporal_tv_residuals;
-      }
+        cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
+    for (int64_t s = 0; s + 1 < layout.num_segments(); ++s) {
+      const LatentLayout::Segment& segment = layout.segment(s);
+      if (segment.constant || layout.segment(s + 1).pixel != segment.pixel) continue;
+      problem.AddResidualBlock(difference, loss, layout.value(s, latent),
+                               layout.value(s + 1, latent));
+      ++statistics.temporal_tv_residuals;
     }
   }
   statistics.distinct_cost_functions = static_cast<int64_t>(built->cost_functions_.size());

@@ -11,6 +11,7 @@
 #include <ceres/ceres.h>
 
 #include "core/video.h"
+#include "solver/latent_layout.h"
 #include "solver/reconstruction_options.h"
 #include "solver/scene.h"
 
@@ -18,7 +19,8 @@ namespace evfs {
 
 /// Residual-block counts of a built problem, per term family.
 struct ProblemStatistics {
-  int64_t parameter_blocks = 0;
+  int64_t parameter_blocks = 0;           // segments of the latent layout, ring ones included
+  int64_t variable_parameter_blocks = 0;  // the unknowns
   int64_t frame_residuals = 0;
   int64_t event_residuals = 0;
   int64_t spatial_tv_residuals = 0;
@@ -39,17 +41,21 @@ class BuiltProblem {
  public:
   ceres::Problem& problem() { return *problem_; }
   const ProblemStatistics& statistics() const { return statistics_; }
+  /// Which voxels the parameter blocks stand for; Expand() the latent video after a solve.
+  const LatentLayout& layout() const { return *layout_; }
 
  private:
   friend class ProblemBuilder;
+  std::unique_ptr<LatentLayout> layout_;
   std::vector<std::unique_ptr<ceres::CostFunction>> cost_functions_;
   std::vector<std::unique_ptr<ceres::LossFunction>> losses_;
   std::unique_ptr<ceres::Problem> problem_;  // declared last: destroyed before the functions
   ProblemStatistics statistics_;
 };
 
-/// Parameter layout: one scalar parameter block per voxel H_t(p), pointing into the latent
-/// Video, and one scalar residual block per term. A prototype on this machine compared it with
+/// Parameter layout: one scalar parameter block per segment of the LatentLayout (per voxel
+/// H_t(p) when quiet steps are not merged), pointing into the latent Video, and one scalar
+/// residual block per term. A prototype on this machine compared it with
 /// one block per pixel time series (vector residuals): that builds faster but has 15× more
 /// Jacobian non-zeros and needs ~12× more LM iterations, because folding the robust loss into
 /// the residual loses Ceres' curvature correction (../shared/notes/solver-measurements.md).
@@ -57,8 +63,10 @@ class ProblemBuilder {
  public:
   ProblemBuilder(const Scene& scene, const ReconstructionOptions& options);
 
-  /// Builds the problem over `latent` (scene.num_latent_frames() frames of the scene's size),
-  /// which must outlive the returned problem. Terms with zero weight are not built.
+  /// Builds the problem over `latent` (scene.num_latent_frames() frames of the scene's size,
+  /// holding the initialisation), which must outlive the returned problem. Each segment of the
+  /// layout starts at the mean of its voxels. Terms with zero weight are not built. After a
+  /// solve, built->layout().Expand(latent) writes the solution to every voxel.
   std::unique_ptr<BuiltProblem> Build(Video* latent) const;
 
  private:

@@ -63,6 +63,11 @@ struct ReconstructionOptions {
   /// their initial value and get no parameter blocks or residuals; < 0 solves every pixel.
   int activity_radius_px = 2;
 
+  /// Hold each active pixel constant between the latent steps where it fired, so that the
+  /// unknowns are its segments rather than its voxels (LatentLayout; the minimiser barely
+  /// changes and the problem is several times smaller). False: one unknown per voxel.
+  bool merge_quiet_steps = true;
+
   /// Ceres settings, all of them available to library users; the defaults below are set by
   /// DefaultSolverOptions() (Levenberg–Marquardt, CGNR with a Jacobi preconditioner).
   ceres::Solver::Options solver;

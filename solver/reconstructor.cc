@@ -47,6 +47,7 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
   summary.iterations = static_cast<int>(summary.ceres.iterations.size()) - 1;
+  built->layout().Expand(&result.video);
   return result;
 }
 

@@ -70,7 +70,7 @@ TEST(FrameResidualAnalytic, MatchesAutoDiff) {
 }
 
 TEST(FrameResidualDeathTest, RejectsEmptyExposure) {
-  EXPECT_DEATH(FrameResidual::Create(0.5, 0), "num_latent_frames");
+  EXPECT_DEATH(FrameResidual::Create(0.5, 0), "run_lengths");
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "solver/problem_builder.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -30,6 +32,7 @@ TEST(ProblemBuilder, BuildsOneResidualPerTermAndPixel) {
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
   options.activity_radius_px = -1;  // every pixel
+  options.merge_quiet_steps = false;  // one parameter block per voxel
   Video latent = InitializeLatentVideo(scene);
   const auto built = ProblemBuilder(scene, options).Build(&latent);
   const ProblemStatistics& stats = built->statistics();
@@ -51,6 +54,7 @@ TEST(ProblemBuilder, ZeroWeightTermsAreNotBuilt) {
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
   options.activity_radius_px = -1;
+  options.merge_quiet_steps = false;
   options.objective.spatial_tv_weight = 0.0;
   options.objective.temporal_tv_weight = 0.0;
   Video latent = InitializeLatentVideo(scene);
@@ -67,6 +71,7 @@ TEST(ProblemBuilder, CostMatchesTheObjectiveWrittenOut) {
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
   options.activity_radius_px = -1;
+  options.merge_quiet_steps = false;
   options.objective.event_weight = 0.0;
   options.objective.spatial_tv_weight = 0.0;
   options.objective.temporal_tv_weight = 0.0;
@@ -88,6 +93,7 @@ TEST(ProblemBuilder, PixelsFarFromEventsAreSkipped) {
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
   options.activity_radius_px = 1;
+  options.merge_quiet_steps = false;
   Video latent = InitializeLatentVideo(scene);
   const auto built = ProblemBuilder(scene, options).Build(&latent);
   const ProblemStatistics& stats = built->statistics();
@@ -102,6 +108,96 @@ TEST(ProblemBuilder, PixelsFarFromEventsAreSkipped) {
   // Horizontal differences touching an active pixel: rows 1..3 × pairs (1,2),(2,3),(3,4) = 9;
   // vertical: columns 2..4 × pairs (0,1),(1,2),(2,3) = 9; per latent frame.
   EXPECT_EQ(stats.spatial_tv_residuals, kLatent * (9 + 9));
+}
+
+TEST(ProblemBuilder, MergedLayoutHasOneUnknownPerQuietRun) {
+  // The one event (x 3, y 2, step 1 → 2) splits its pixel into H_0..1 and H_2..3; every other
+  // pixel is one constant-in-time unknown.
+  const Scene scene = MakeTinyScene();
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  options.activity_radius_px = -1;
+  Video latent = InitializeLatentVideo(scene);
+  const auto built = ProblemBuilder(scene, options).Build(&latent);
+  const ProblemStatistics& stats = built->statistics();
+  EXPECT_EQ(stats.parameter_blocks, 19 + 2);
+  EXPECT_EQ(stats.variable_parameter_blocks, 19 + 2);
+  EXPECT_EQ(stats.frame_residuals, 2 * 20);
+  EXPECT_EQ(stats.event_residuals, 1);
+  EXPECT_EQ(stats.temporal_tv_residuals, 1);
+  // 31 neighbour pairs, one run each, except the 4 pairs of the split pixel (two runs each).
+  EXPECT_EQ(stats.spatial_tv_residuals, 31 + 4);
+  // Each unknown starts at the mean of the blend over its frames.
+  EXPECT_NEAR(latent.at(0, 0, 0), 0.4, 1e-12);
+  EXPECT_NEAR(latent.at(3, 0, 0), 0.4, 1e-12);
+  EXPECT_NEAR(latent.at(1, 2, 3), 0.2 + 0.4 / 6.0, 1e-12);
+  EXPECT_NEAR(latent.at(2, 2, 3), 0.6 - 0.4 / 6.0, 1e-12);
+}
+
+// Cost and gradient of `problem` at its current values, the gradient in `blocks`' order.
+double EvaluateProblem(ceres::Problem* problem, const std::vector<double*>& blocks,
+                       std::vector<double>* gradient) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  evaluate.num_threads = 1;
+  double cost = 0.0;
+  problem->Evaluate(evaluate, &cost, nullptr, gradient, nullptr);
+  return cost;
+}
+
+TEST(ProblemBuilder, MergedProblemIsTheFullProblemOnSegmentConstantVideos) {
+  // On any video constant over each segment, the merged problem has the full problem's cost,
+  // and its gradient is the sum of the full gradient over each segment's voxels.
+  const testing::SyntheticRecording recording(24, 20, 0.012);
+  TimedFrame blurred = recording.Blurred(6, 12);  // a mixed scene: sharp first, blurred last
+  const Scene scene = MakeScene({recording.Sharp(0), blurred}, recording.events,
+                                recording.rendered.timestamp_ns(0),
+                                recording.rendered.timestamp_ns(12) + 1, BinningOptions());
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 8.0;
+  Video merged_video = InitializeLatentVideo(scene);
+  const auto merged = ProblemBuilder(scene, options).Build(&merged_video);
+  const LatentLayout& layout = merged->layout();
+  ASSERT_LT(layout.num_variable_segments(),
+            merged->statistics().active_pixels * scene.num_latent_frames());
+  // Move every unknown to a pseudo-random value in [0.1, 0.9].
+  std::vector<double*> segment_blocks;
+  for (int64_t s = 0; s < layout.num_segments(); ++s) {
+    if (layout.segment(s).constant) continue;
+    double* value = layout.value(s, &merged_video);
+    *value = 0.1 + 0.8 * std::fmod(0.618034 * static_cast<double>(s), 1.0);
+    segment_blocks.push_back(value);
+  }
+  layout.Expand(&merged_video);
+
+  options.merge_quiet_steps = false;
+  Video full_video = merged_video;
+  const auto full = ProblemBuilder(scene, options).Build(&full_video);
+  std::vector<double*> voxel_blocks;
+  for (int64_t s = 0; s < layout.num_segments(); ++s) {
+    const LatentLayout::Segment& segment = layout.segment(s);
+    if (segment.constant) continue;
+    for (int t = segment.first; t <= segment.last; ++t) {
+      voxel_blocks.push_back(full_video.frame_data(t) + segment.pixel);
+    }
+  }
+  std::vector<double> merged_gradient, full_gradient;
+  const double merged_cost = EvaluateProblem(&merged->problem(), segment_blocks, &merged_gradient);
+  const double full_cost = EvaluateProblem(&full->problem(), voxel_blocks, &full_gradient);
+  EXPECT_NEAR(merged_cost, full_cost, 1e-12 * full_cost);
+  size_t voxel = 0;
+  double max_difference = 0.0, max_gradient = 0.0;
+  for (size_t i = 0, s = 0; s < static_cast<size_t>(layout.num_segments()); ++s) {
+    const LatentLayout::Segment& segment = layout.segment(s);
+    if (segment.constant) continue;
+    double sum = 0.0;
+    for (int t = segment.first; t <= segment.last; ++t) sum += full_gradient[voxel++];
+    max_difference = std::max(max_difference, std::abs(sum - merged_gradient[i]));
+    max_gradient = std::max(max_gradient, std::abs(sum));
+    ++i;
+  }
+  EXPECT_GT(max_gradient, 0.0);
+  EXPECT_LE(max_difference, 1e-9 * max_gradient);
 }
 
 TEST(ProblemBuilder, InitialisationBlendsLinearlyInTime) {

@@ -1,0 +1,78 @@
+// The unknowns of a reconstruction: which latent voxels H_t(p) are solved for, and which of them
+// share one value (DESIGN.md §3, "skipping what a scene does not need").
+//
+// Each pixel in the problem has its time series H_0(p) … H_K(p) cut into segments of
+// consecutive latent frames that share one value. An active pixel starts a new segment only at
+// a latent step inside an event frame that fired at the pixel: between its events the pixel
+// is constant. A ring pixel (held constant) starts one where its initial value changes.
+//
+// Why merging quiet steps changes the reconstruction so little: at a step where the pixel did not
+// fire, any change d costs λ_e|tanh(α d)| + λ_t|d| (event and temporal terms), more than the
+// frame terms can gain from it (at most |d| per frame weight), so the minimiser of the full
+// problem keeps the pixel constant there anyway. On slider_depth the merged layout has about a
+// tenth of the unknowns, which is what the solve time follows.
+//
+// Storage: a segment's value lives in the latent Video, in the voxel of its first frame, so
+// a ceres::Problem over segments is a problem over voxels of that Video. Expand() copies each
+// value to the rest of its segment after a solve.
+#ifndef EVFS_SOLVER_LATENT_LAYOUT_H_
+#define EVFS_SOLVER_LATENT_LAYOUT_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "core/video.h"
+#include "solver/activity_mask.h"
+#include "solver/scene.h"
+
+namespace evfs {
+
+class LatentLayout {
+ public:
+  struct Segment {
+    int64_t pixel = 0;
+    int first = 0;  // first latent frame
+    int last = 0;   // last latent frame (inclusive)
+    bool constant = false;  // a ring pixel's segment: held at its initial value
+    int length() const { return last - first + 1; }
+  };
+
+  /// Segments for every pixel the mask puts in the problem. With `merge_quiet_steps` false every
+  /// voxel is its own segment (the plain per-voxel layout). `initial` is the initial latent video
+  /// (for ring pixels' constants).
+  LatentLayout(const Scene& scene, const ActivityMask& mask, const Video& initial,
+               bool merge_quiet_steps);
+
+  int num_latent_frames() const { return num_latent_frames_; }
+  int64_t pixels_per_frame() const { return pixels_per_frame_; }
+  int64_t num_segments() const { return static_cast<int64_t>(segments_.size()); }
+  int64_t num_variable_segments() const { return num_variable_segments_; }
+  const Segment& segment(int64_t s) const { return segments_[s]; }
+
+  /// Index of the segment holding H_t(p), or -1 when pixel p is not in the problem.
+  int64_t segment_at(int t, int64_t p) const {
+    return segment_of_voxel_[static_cast<size_t>(t) * pixels_per_frame_ + p];
+  }
+
+  /// The storage of segment s inside `latent`: the voxel of its first frame.
+  double* value(int64_t s, Video* latent) const {
+    return latent->frame_data(segments_[s].first) + segments_[s].pixel;
+  }
+
+  /// Sets every variable segment's value to the mean of `latent` over the segment, so that the
+  /// initialisation is a point of the merged parameter space.
+  void ProjectOnto(Video* latent) const;
+  /// Copies each segment's value to every voxel of the segment (after a solve).
+  void Expand(Video* latent) const;
+
+ private:
+  int num_latent_frames_ = 0;
+  int64_t pixels_per_frame_ = 0;
+  std::vector<Segment> segments_;
+  int64_t num_variable_segments_ = 0;
+  std::vector<int32_t> segment_of_voxel_;  // t-major: [t * pixels + p]
+};
+
+}  // namespace evfs
+
+#endif  // EVFS_SOLVER_LATENT_LAYOUT_H_
