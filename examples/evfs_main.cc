@@ -80,6 +80,10 @@ DEFINE_double(eta, evfs::DefaultSolverOptions().eta, "Inexact Newton forcing seq
 DEFINE_int32(max_iterations, evfs::DefaultSolverOptions().max_num_iterations, "Most Levenberg-Marquardt iterations.");
 DEFINE_int32(max_linear_iterations, evfs::DefaultSolverOptions().max_linear_solver_iterations, "Most CG iterations per LM step.");
 DEFINE_double(max_time_s, 1e6, "Stop the solve after this many seconds.");
+DEFINE_int32(bounds_line_search_iterations,
+             evfs::DefaultSolverOptions().max_num_line_search_step_size_iterations,
+             "Steps of Ceres' projected line search after each bounded trust-region step "
+             "(0: none; the step is only projected onto the bounds).");
 DEFINE_double(function_tolerance, evfs::DefaultSolverOptions().function_tolerance, "Stop when the relative cost change falls below this.");
 DEFINE_int32(threads, evfs::DefaultSolverOptions().num_threads, "Threads for Jacobian evaluation and the linear solver.");
 DEFINE_bool(progress, false, "Print a line per iteration even when stderr is not a terminal.");
@@ -266,6 +270,7 @@ ReconstructRequest RequestFromFlags() {
   solver.max_linear_solver_iterations = FLAGS_max_linear_iterations;
   solver.max_solver_time_in_seconds = FLAGS_max_time_s;
   solver.function_tolerance = FLAGS_function_tolerance;
+  solver.max_num_line_search_step_size_iterations = FLAGS_bounds_line_search_iterations;
   solver.num_threads = FLAGS_threads;
   return request;
 }

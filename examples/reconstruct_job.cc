@@ -210,6 +210,18 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
                                                  summary.ceres.termination_type)
                                            : "NOT_SOLVED");
   json.Field("message", summary.solved ? summary.ceres.message : summary.skipped_reason);
+  if (summary.solved) {
+    // Where Ceres' time went (its own accounting).
+    json.Key("time_s").BeginObject();
+    json.Field("preprocessor", summary.ceres.preprocessor_time_in_seconds);
+    json.Field("residual_evaluation", summary.ceres.residual_evaluation_time_in_seconds);
+    json.Field("jacobian_evaluation", summary.ceres.jacobian_evaluation_time_in_seconds);
+    json.Field("linear_solver", summary.ceres.linear_solver_time_in_seconds);
+    json.Field("minimizer", summary.ceres.minimizer_time_in_seconds);
+    json.EndObject();
+    json.Field("successful_steps", summary.ceres.num_successful_steps);
+    json.Field("unsuccessful_steps", summary.ceres.num_unsuccessful_steps);
+  }
   json.EndObject();
   json.Key("model").BeginObject();
   json.Field("event_model", EventModelName(objective.event_model.model));
