@@ -34,7 +34,13 @@ DEFINE_string(clips,
 DEFINE_string(csv, "", "Also write the rows as CSV to this file.");
 // Overrides of the defaults, for exploring them; the published figures use none.
 DEFINE_double(alpha, evfs::ObjectiveOptions().event_model.alpha, "alpha; 0 derives it.");
+DEFINE_double(frame_weight, evfs::ObjectiveOptions().frame_weight, "weight of the frame term.");
+DEFINE_double(event_weight, evfs::ObjectiveOptions().event_weight, "lambda_e.");
+DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight, "lambda_t.");
 DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight, "lambda_xy.");
+DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
+            "one unknown per quiet run of a pixel (false: per voxel).");
+DEFINE_string(init, "blend", "blend | events: where the solve starts.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "auto binning's voxel budget.");
 
@@ -72,6 +78,10 @@ ReconstructionOptions Options() {
   ReconstructionOptions options;
   options.objective.event_model.alpha = FLAGS_alpha;
   options.objective.spatial_tv_weight = FLAGS_spatial_tv_weight;
+  options.objective.frame_weight = FLAGS_frame_weight;
+  options.objective.event_weight = FLAGS_event_weight;
+  options.objective.temporal_tv_weight = FLAGS_temporal_tv_weight;
+  options.merge_quiet_steps = FLAGS_merge_quiet_steps;
   return options;
 }
 
@@ -113,6 +123,7 @@ Row RunTruthCase(const std::string& snippet, Mode mode, int first, int last, int
   request.truth = truth;
   request.options = Options();
   request.binning = Binning();
+  request.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   Row row{snippet, ModeName(mode), "PSNR dB (frame " + std::to_string(truth) + ")",
@@ -131,6 +142,7 @@ std::vector<Row> RunCupsDeblur(int frame) {
   request.first = frame;
   request.options = Options();
   request.binning = Binning();
+  request.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   const double wall_s = SecondsSince(start);
@@ -178,7 +190,10 @@ Row RunClipInterpolation(const std::string& name, const Clip& clip) {
   const auto start = Clock::now();
   const Scene scene =
       MakeInterpolationScene(Sharp(clip.frames, 0), Sharp(clip.frames, 4), clip.events, Binning());
-  const Reconstruction result = Reconstruct(scene, Options());
+  std::string initial_method;
+  const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
+                                           BaselineOptions(), &initial_method);
+  const Reconstruction result = Reconstruct(scene, Options(), &initial);
   const int index = result.video.NearestFrame(clip.frames.timestamp_ns(2));
   const Image& truth = clip.frames.frame(2);
   return Row{name, "interpolate", "PSNR dB (frame 2 from 0, 4)",
@@ -196,7 +211,10 @@ Row RunClipDeblur(const std::string& name, const Clip& clip) {
   for (int t = 0; t < kBlurFrames; ++t) blurred.image += clip.frames.frame(t);
   blurred.image /= kBlurFrames;
   const Scene scene = MakeDeblurScene(blurred, clip.events, Binning());
-  const Reconstruction result = Reconstruct(scene, Options());
+  std::string initial_method;
+  const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
+                                           BaselineOptions(), &initial_method);
+  const Reconstruction result = Reconstruct(scene, Options(), &initial);
   double blurred_psnr = 0.0, evfs_psnr = 0.0;
   for (int t = 0; t < kBlurFrames; ++t) {
     const int index = result.video.NearestFrame(clip.frames.timestamp_ns(t));

@@ -69,6 +69,9 @@ DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale, "epsilo
 DEFINE_bool(bounds, true, "Keep intensities in [0, 1].");
 DEFINE_int32(activity_radius_px, evfs::ReconstructionOptions().activity_radius_px, "Solve only pixels within this distance of an event of the "
              "window; the others keep their initial value. -1 solves every pixel.");
+DEFINE_string(init, evfs::InitializationName(evfs::ReconstructRequest().initialization),
+              "Where the solve starts: blend (the frames blended in time) | events (event "
+              "integration from a sharp frame, else EDI for a blurred one).");
 DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps, "Hold a pixel "
             "constant between the latent steps where it fired (one unknown per quiet run); "
             "false: one unknown per voxel.");
@@ -259,6 +262,7 @@ ReconstructRequest RequestFromFlags() {
   request.options.bound_intensities = FLAGS_bounds;
   request.options.activity_radius_px = FLAGS_activity_radius_px;
   request.options.merge_quiet_steps = FLAGS_merge_quiet_steps;
+  request.initialization = evfs::ParseInitialization(FLAGS_init);
 
   ceres::Solver::Options& solver = request.options.solver;
   Require(ceres::StringToLinearSolverType(FLAGS_linear_solver, &solver.linear_solver_type),

@@ -156,7 +156,9 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   result.time.bin_s = SecondsSince(bin_start);
 
   result.baseline = InitializeLatentVideo(scene);
-  result.reconstruction = Reconstruct(scene, request.options);
+  const Video initial = InitialLatentVideo(scene, request.initialization, request.baseline,
+                                           &result.initialization);
+  result.reconstruction = Reconstruct(scene, request.options, &initial);
   result.time.build_s = result.reconstruction.summary.build_time_s;
   result.time.solve_s = result.reconstruction.summary.solve_time_s;
   const Video& latent = result.reconstruction.video;
@@ -206,6 +208,7 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json.Field("function_tolerance", options.solver.function_tolerance);
   json.Field("threads", options.solver.num_threads);
   json.Field("bounds", options.bound_intensities);
+  json.Field("initialization", result.initialization);
   json.Field("termination", summary.solved ? ceres::TerminationTypeToString(
                                                  summary.ceres.termination_type)
                                            : "NOT_SOLVED");

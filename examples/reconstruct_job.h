@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <string>
 
+#include "baselines/baseline_options.h"
 #include "core/video.h"
+#include "examples/initialization.h"
 #include "solver/reconstruction_options.h"
 #include "solver/reconstructor.h"
 #include "solver/scene.h"
@@ -31,6 +33,8 @@ struct ReconstructRequest {
   double fps = 0.0;         // > 0: resample the latent video to this uniform rate
   BinningOptions binning;
   ReconstructionOptions options;  // objective.event_model.alpha <= 0: derive α from the data
+  Initialization initialization = Initialization::kBlend;
+  BaselineOptions baseline;  // the classical methods' parameters (initialisation, baselines)
 };
 
 struct TruthScore {
@@ -52,7 +56,8 @@ struct ReconstructResult {
   int event_frames = 0;
   Reconstruction reconstruction;  // latent video and solver summary
   Video output;                   // the latent video, or its resampling at request.fps
-  Video baseline;                 // the initialisation (blend or copy) on the latent timeline
+  Video baseline;                 // blend or copy on the latent timeline (the score's reference)
+  std::string initialization;     // what the solve started from ("blend", "integrate", "edi")
   bool has_truth = false;
   TruthScore truth;
   StageTimes time;

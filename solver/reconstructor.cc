@@ -13,7 +13,8 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options) {
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
+                           const Video* initial) {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
   Reconstruction result;
@@ -28,7 +29,15 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     result.summary.model.description = "alpha " + std::to_string(event_model.alpha) + " (given)";
   }
 
-  result.video = InitializeLatentVideo(scene);
+  if (initial != nullptr) {
+    if (initial->num_frames() != scene.num_latent_frames() || initial->height() != scene.height ||
+        initial->width() != scene.width) {
+      throw InvalidArgumentError("the initial video does not match the scene's latent timeline");
+    }
+    result.video = *initial;
+  } else {
+    result.video = InitializeLatentVideo(scene);
+  }
   ReconstructionSummary& summary = result.summary;
   if (scene.num_events == 0) {
     summary.skipped_reason = "no events in the window: the initialisation is the answer";

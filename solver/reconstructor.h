@@ -34,10 +34,13 @@ struct Reconstruction {
   ReconstructionSummary summary;
 };
 
-/// Reconstructs the latent video of `scene`. Throws InvalidArgumentError for invalid options.
-/// α <= 0 in the options is derived from the scene first. A scene without events is answered
-/// with its initialisation, without a solve.
-Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options);
+/// Reconstructs the latent video of `scene`, starting from `initial` (the scene's latent
+/// timeline; e.g. a classical estimate from baselines/) or, when null, from
+/// InitializeLatentVideo(scene). Throws InvalidArgumentError for invalid options or an initial
+/// video of another shape. α <= 0 in the options is derived from the scene first. A scene
+/// without events is answered with its initialisation, without a solve.
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
+                           const Video* initial = nullptr);
 
 }  // namespace evfs
 

@@ -66,7 +66,7 @@ TEST(ProblemBuilder, ZeroWeightTermsAreNotBuilt) {
 
 TEST(ProblemBuilder, CostMatchesTheObjectiveWrittenOut) {
   // Only the frame term on a blend: each frame is matched exactly except that the latent ends
-  // are shifted by 0.1, so the cost is 2 frames × 20 pixels × (sqrt(ε² + 0.1²) − ε) / 20.
+  // are shifted by 0.1, so the cost is w × 2 frames × 20 pixels × (sqrt(ε² + 0.1²) − ε) / 20.
   const Scene scene = MakeTinyScene();
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
@@ -82,7 +82,8 @@ TEST(ProblemBuilder, CostMatchesTheObjectiveWrittenOut) {
   double cost = 0.0;
   built->problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
   const double eps = options.objective.smoothing_scale;
-  const double expected = 2.0 * (std::sqrt(eps * eps + 0.01) - eps);
+  const double expected =
+      options.objective.frame_weight * 2.0 * (std::sqrt(eps * eps + 0.01) - eps);
   constexpr double kTolerance = 1e-12;  // a handful of double additions
   EXPECT_NEAR(cost, expected, kTolerance);
 }
