@@ -121,15 +121,15 @@ Row RunTruthCase(const std::string& snippet, Mode mode, int first, int last, int
   request.first = first;
   request.last = last;
   request.truth = truth;
-  request.options = Options();
+  request.method.reconstruction = Options();
   request.binning = Binning();
-  request.initialization = ParseInitialization(FLAGS_init);
+  request.method.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   Row row{snippet, ModeName(mode), "PSNR dB (frame " + std::to_string(truth) + ")",
           result.truth.baseline_psnr, result.truth.psnr,
           mode == Mode::kInterpolate ? "blend" : "copy",
-          result.reconstruction.video.num_frames(), SecondsSince(start)};
+          result.run.video.num_frames(), SecondsSince(start)};
   return row;
 }
 
@@ -140,13 +140,13 @@ std::vector<Row> RunCupsDeblur(int frame) {
   request.data_path = (fs::path(FLAGS_data) / "eslnet_cups_blur").string();
   request.mode = Mode::kDeblur;
   request.first = frame;
-  request.options = Options();
+  request.method.reconstruction = Options();
   request.binning = Binning();
-  request.initialization = ParseInitialization(FLAGS_init);
+  request.method.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   const double wall_s = SecondsSince(start);
-  const Video& latent = result.reconstruction.video;
+  const Video& latent = result.run.video;
   const Image blurred = result.baseline.frame(0);
   Image mean = Image::Zero(latent.height(), latent.width());
   double sharpness = 0.0;

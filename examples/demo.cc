@@ -115,7 +115,7 @@ int RunDemo(const std::string& out_dir) {
     WriteReconstruction(request, &result, (out / demo_case.name).string());
 
     // Score the latent frame nearest to the truth time against the exact rendering there.
-    const Video& latent = result.reconstruction.video;
+    const Video& latent = result.run.video;
     const int index = latent.NearestFrame(SecondsToNanoseconds(demo_case.truth_s));
     const Image truth = synthesizer.Render(latent.timestamp_s(index));
     const double psnr = Psnr(latent.frame(index), truth);

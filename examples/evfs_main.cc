@@ -45,6 +45,23 @@ DEFINE_double(exposure_s, 0.0, "deblur: exposure around the frame's timestamp, w
               "has no exposures.txt.");
 DEFINE_double(fps, 0.0, "Resample the latent video to this uniform frame rate; 0 writes the "
               "latent frames themselves.");
+// Method.
+DEFINE_string(solver, "ceres_lm", "Method: ceres_lm (default: Levenberg-Marquardt in Ceres) | "
+              "ceres_lbfgs | adam (the paper's optimiser and schedule, true l1) | adam_smooth "
+              "(the same on the smoothed objective) | blend | copy | integrate | cf | edi "
+              "(classical baselines).");
+DEFINE_bool(checkpoints, false, "Record cost (and PSNR/SSIM against --truth) at every iteration "
+            "of an iterative solver into summary.json.");
+DEFINE_int32(adam_iterations, evfs::AdamOptions().max_iterations, "adam, adam_smooth: steps.");
+DEFINE_double(adam_learning_rate, evfs::AdamOptions().learning_rate,
+              "adam, adam_smooth: initial learning rate (divided by 5 every 200 steps).");
+DEFINE_double(contrast_threshold, evfs::BaselineOptions().contrast_threshold,
+              "integrate, cf, edi (and --init=events): change one event stands for; 0 derives "
+              "it from the data.");
+DEFINE_double(blur_sigma_px, evfs::BaselineOptions().blur_sigma_px,
+              "integrate: Gaussian blur (pixels) after integration; 0: none.");
+DEFINE_double(cf_cutoff_rad_per_s, evfs::BaselineOptions().cutoff_rad_per_s,
+              "cf: crossover frequency of the complementary filter.");
 // Binning.
 DEFINE_string(binning, "auto", "auto | collision | stacked. auto: collision binning (the "
               "paper's), unless it gives more than --max_latent_frames frames.");
@@ -69,7 +86,7 @@ DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale, "epsilo
 DEFINE_bool(bounds, true, "Keep intensities in [0, 1].");
 DEFINE_int32(activity_radius_px, evfs::ReconstructionOptions().activity_radius_px, "Solve only pixels within this distance of an event of the "
              "window; the others keep their initial value. -1 solves every pixel.");
-DEFINE_string(init, evfs::InitializationName(evfs::ReconstructRequest().initialization),
+DEFINE_string(init, evfs::InitializationName(evfs::MethodOptions().initialization),
               "Where the solve starts: blend (the frames blended in time) | events (event "
               "integration from a sharp frame, else EDI for a blurred one).");
 DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps, "Hold a pixel "
@@ -212,16 +229,12 @@ int RunSimulate() {
   return 0;
 }
 
-// One progress line per Ceres iteration.
-class ProgressPrinter : public ceres::IterationCallback {
- public:
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-    std::fprintf(stderr, "iter %3d  cost %.6e  change %+.3e  cg %3d  %.2f s\n",
-                 summary.iteration, summary.cost, -summary.cost_change,
-                 summary.linear_solver_iterations, summary.cumulative_time_in_seconds);
-    return ceres::SOLVER_CONTINUE;
-  }
-};
+// One progress line per iteration of an iterative solver.
+bool PrintProgress(const SolverIteration& iteration) {
+  std::fprintf(stderr, "iter %4d  cost %.6e  %.2f s\n", iteration.iteration, iteration.cost,
+               iteration.elapsed_s);
+  return true;
+}
 
 ReconstructRequest RequestFromFlags() {
   ReconstructRequest request;
@@ -247,7 +260,20 @@ ReconstructRequest RequestFromFlags() {
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   binning.stacked.num_frames = FLAGS_stacked_frames;
 
-  ObjectiveOptions& objective = request.options.objective;
+  MethodOptions& method = request.method;
+  method.method = ParseMethod(FLAGS_solver);
+  method.initialization = ParseInitialization(FLAGS_init);
+  method.adam.max_iterations = FLAGS_adam_iterations;
+  method.adam.learning_rate = FLAGS_adam_learning_rate;
+  method.adam.num_threads = FLAGS_threads;
+  method.lbfgs.num_threads = FLAGS_threads;
+  method.baseline.contrast_threshold = FLAGS_contrast_threshold;
+  method.baseline.blur_sigma_px = FLAGS_blur_sigma_px;
+  method.baseline.cutoff_rad_per_s = FLAGS_cf_cutoff_rad_per_s;
+  request.checkpoints = FLAGS_checkpoints;
+
+  ReconstructionOptions& options = method.reconstruction;
+  ObjectiveOptions& objective = options.objective;
   objective.frame_weight = FLAGS_frame_weight;
   objective.event_weight = FLAGS_event_weight;
   objective.spatial_tv_weight = FLAGS_spatial_tv_weight;
@@ -259,12 +285,11 @@ ReconstructRequest RequestFromFlags() {
           "--event_model must be linear or log");
   Require(ParseSpatialTv(FLAGS_spatial_tv, &objective.spatial_tv),
           "--spatial_tv must be paper, anisotropic or isotropic");
-  request.options.bound_intensities = FLAGS_bounds;
-  request.options.activity_radius_px = FLAGS_activity_radius_px;
-  request.options.merge_quiet_steps = FLAGS_merge_quiet_steps;
-  request.initialization = evfs::ParseInitialization(FLAGS_init);
+  options.bound_intensities = FLAGS_bounds;
+  options.activity_radius_px = FLAGS_activity_radius_px;
+  options.merge_quiet_steps = FLAGS_merge_quiet_steps;
 
-  ceres::Solver::Options& solver = request.options.solver;
+  ceres::Solver::Options& solver = options.solver;
   Require(ceres::StringToLinearSolverType(FLAGS_linear_solver, &solver.linear_solver_type),
           "unknown --linear_solver " + FLAGS_linear_solver);
   Require(ceres::StringToPreconditionerType(FLAGS_preconditioner, &solver.preconditioner_type),
@@ -284,26 +309,27 @@ int RunReconstruct() {
   Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
   Require(FLAGS_first >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
   ReconstructRequest request = RequestFromFlags();
-  ProgressPrinter progress;
-  if (FLAGS_progress || ::isatty(STDERR_FILENO)) {
-    request.options.solver.callbacks.push_back(&progress);
-    request.options.solver.update_state_every_iteration = false;
-  }
+  if (FLAGS_progress || ::isatty(STDERR_FILENO)) request.progress = PrintProgress;
   ReconstructResult result = RunReconstruction(request);
   WriteReconstruction(request, &result, FLAGS_out);
 
-  const ReconstructionSummary& summary = result.reconstruction.summary;
+  const MethodResult& run = result.run;
   std::printf("%s: %dx%d, %lld events, %d event frames, %d latent frames\n",
               ModeName(result.mode), result.width, result.height,
               static_cast<long long>(result.events), result.event_frames,
-              result.reconstruction.video.num_frames());
-  std::printf("model: %s\n", result.reconstruction.summary.model.description.c_str());
-  if (summary.solved) {
-    std::printf("solve: %d iterations, cost %.6g -> %.6g (%s)\n", summary.iterations,
-                summary.initial_cost, summary.final_cost,
-                ceres::TerminationTypeToString(summary.ceres.termination_type));
+              run.video.num_frames());
+  if (IsIterative(request.method.method)) {
+    std::printf("model: %s\n", run.reconstruction.model.description.c_str());
+    if (run.solved) {
+      std::printf("solve: %s from %s, %d iterations, cost %.6g -> %.6g (%s)\n",
+                  run.method.c_str(), run.initialization.c_str(), run.iterations,
+                  run.initial_cost, run.final_cost, run.message.c_str());
+    } else {
+      std::printf("solve: skipped (%s)\n", run.message.c_str());
+    }
   } else {
-    std::printf("solve: skipped (%s)\n", summary.skipped_reason.c_str());
+    std::printf("method: %s%s%s\n", run.method.c_str(), run.threshold_source.empty() ? "" : ", ",
+                run.threshold_source.c_str());
   }
   if (result.has_truth) {
     std::printf("truth: frame %d vs latent %d: PSNR %.2f dB, SSIM %.4f (%s: %.2f dB, %.4f)\n",

@@ -24,6 +24,17 @@ class JsonWriter {
     text_ += '}';
     return *this;
   }
+  JsonWriter& BeginArray() {
+    Separate();
+    text_ += '[';
+    first_.push_back(true);
+    return *this;
+  }
+  JsonWriter& EndArray() {
+    first_.pop_back();
+    text_ += ']';
+    return *this;
+  }
   /// Starts a member; the next Begin/Value call writes its value.
   JsonWriter& Key(const std::string& key) {
     Separate();

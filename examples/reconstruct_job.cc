@@ -22,6 +22,11 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+// Most frames --fps may resample the latent video to (a runaway rate would fill memory).
+constexpr double kMaxOutputFrames = 10000;
+// Longest --exposure_s: keeps t +- exposure / 2 far inside int64 nanoseconds.
+constexpr double kMaxExposureS = 3600.0;
+
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -101,10 +106,16 @@ const char* ModeName(Mode mode) {
 ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   const auto total_start = Clock::now();
   std::string error;
-  if (!request.options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
+  if (!request.method.reconstruction.IsValid(&error)) {
+    throw InvalidArgumentError("invalid options: " + error);
+  }
   if (!request.binning.IsValid(&error)) throw InvalidArgumentError("invalid binning: " + error);
   if (request.fps < 0.0 || !std::isfinite(request.fps)) {
     throw InvalidArgumentError("--fps must be positive (or 0 for the latent timeline)");
+  }
+  if (!(request.exposure_s >= 0.0 && request.exposure_s <= kMaxExposureS)) {
+    throw InvalidArgumentError("--exposure_s must be between 0 and " +
+                               std::to_string(static_cast<int>(kMaxExposureS)) + " seconds");
   }
 
   ReconstructResult result;
@@ -144,6 +155,12 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
       window_end_ns = frames.front().exposure_end_ns;
       break;
   }
+  const double window_s = NanosecondsToSeconds(window_end_ns - window_begin_ns);
+  if (request.fps * window_s > kMaxOutputFrames) {
+    throw InvalidArgumentError("--fps would resample the " + std::to_string(window_s) +
+                               " s window to more than " +
+                               std::to_string(static_cast<int>(kMaxOutputFrames)) + " frames");
+  }
   const EventStream events = source->ReadEvents(window_begin_ns, window_end_ns);
   Image truth_image;
   if (request.truth >= 0) truth_image = source->ReadImage(request.truth);
@@ -156,22 +173,32 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   result.time.bin_s = SecondsSince(bin_start);
 
   result.baseline = InitializeLatentVideo(scene);
-  const Video initial = InitialLatentVideo(scene, request.initialization, request.baseline,
-                                           &result.initialization);
-  result.reconstruction = Reconstruct(scene, request.options, &initial);
-  result.time.build_s = result.reconstruction.summary.build_time_s;
-  result.time.solve_s = result.reconstruction.summary.solve_time_s;
-  const Video& latent = result.reconstruction.video;
+  CheckpointTruth checkpoint_truth;
+  const bool score = request.truth >= 0;
+  if (score) {
+    result.truth.timestamp_ns = source->frames()[request.truth].t_ns;
+    if (result.truth.timestamp_ns < window_begin_ns || result.truth.timestamp_ns > window_end_ns) {
+      throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
+                                 " lies outside the reconstructed window");
+    }
+    checkpoint_truth.image = &truth_image;
+    checkpoint_truth.latent_index = result.baseline.NearestFrame(result.truth.timestamp_ns);
+  }
+  std::string why_not;
+  if (!MethodSupports(request.method.method, scene, &why_not)) {
+    throw InvalidArgumentError(std::string("--solver=") + MethodName(request.method.method) +
+                               " cannot reconstruct this case: " + why_not);
+  }
+  result.run = RunMethod(scene, request.method, request.progress, request.checkpoints,
+                         score ? &checkpoint_truth : nullptr);
+  result.time.build_s = result.run.build_time_s;
+  result.time.solve_s = result.run.solve_time_s;
+  const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
 
   if (request.truth >= 0) {
     TruthScore& truth = result.truth;
     truth.index = request.truth;
-    truth.timestamp_ns = source->frames()[request.truth].t_ns;
-    if (truth.timestamp_ns < window_begin_ns || truth.timestamp_ns > window_end_ns) {
-      throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
-                                 " lies outside the reconstructed window");
-    }
     truth.latent_index = latent.NearestFrame(truth.timestamp_ns);
     const Image estimate = latent.frame(truth.latent_index);
     truth.psnr = Psnr(estimate, truth_image);
@@ -185,10 +212,76 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   return result;
 }
 
+namespace {
+
+void WriteCeresLm(const ReconstructionOptions& options, const ReconstructionSummary& summary,
+                  JsonWriter* json) {
+  json->Field("linear_solver", ceres::LinearSolverTypeToString(options.solver.linear_solver_type));
+  json->Field("preconditioner",
+              ceres::PreconditionerTypeToString(options.solver.preconditioner_type));
+  json->Field("eta", options.solver.eta);
+  json->Field("max_iterations", options.solver.max_num_iterations);
+  json->Field("function_tolerance", options.solver.function_tolerance);
+  json->Field("threads", options.solver.num_threads);
+  if (!summary.solved) return;
+  json->Field("termination", ceres::TerminationTypeToString(summary.ceres.termination_type));
+  // Where Ceres' time went (its own accounting).
+  json->Key("time_s").BeginObject();
+  json->Field("preprocessor", summary.ceres.preprocessor_time_in_seconds);
+  json->Field("residual_evaluation", summary.ceres.residual_evaluation_time_in_seconds);
+  json->Field("jacobian_evaluation", summary.ceres.jacobian_evaluation_time_in_seconds);
+  json->Field("linear_solver", summary.ceres.linear_solver_time_in_seconds);
+  json->Field("minimizer", summary.ceres.minimizer_time_in_seconds);
+  json->EndObject();
+  json->Field("successful_steps", summary.ceres.num_successful_steps);
+  json->Field("unsuccessful_steps", summary.ceres.num_unsuccessful_steps);
+}
+
+void WriteModel(const ObjectiveOptions& objective, const ReconstructionSummary& summary,
+                JsonWriter* json) {
+  json->Key("model").BeginObject();
+  json->Field("event_model", EventModelName(objective.event_model.model));
+  json->Field("alpha", summary.model.alpha);
+  json->Field("alpha_derived", summary.alpha_derived);
+  if (summary.alpha_derived) {
+    json->Field("change_per_event", summary.model.change_per_event);
+    json->Field("change_measured_from_frames", summary.model.estimated_from_frames);
+  }
+  json->Field("frame_weight", objective.frame_weight);
+  json->Field("event_weight", objective.event_weight);
+  json->Field("spatial_tv_weight", objective.spatial_tv_weight);
+  json->Field("temporal_tv_weight", objective.temporal_tv_weight);
+  json->Field("spatial_tv", SpatialTvName(objective.spatial_tv));
+  json->Field("smoothing_scale", objective.smoothing_scale);
+  json->EndObject();
+}
+
+void WriteProblem(const ReconstructionOptions& options, const ProblemStatistics& problem,
+                  JsonWriter* json) {
+  json->Key("pixels").BeginObject();
+  json->Field("active", problem.active_pixels);
+  json->Field("skipped", problem.skipped_pixels);
+  json->Field("activity_radius_px", options.activity_radius_px);
+  json->Field("merge_quiet_steps", options.merge_quiet_steps);
+  json->EndObject();
+  json->Key("problem").BeginObject();
+  json->Field("parameter_blocks", problem.parameter_blocks);
+  json->Field("unknowns", problem.variable_parameter_blocks);
+  json->Field("residual_blocks", problem.residual_blocks());
+  json->Field("frame_residuals", problem.frame_residuals);
+  json->Field("event_residuals", problem.event_residuals);
+  json->Field("spatial_tv_residuals", problem.spatial_tv_residuals);
+  json->Field("temporal_tv_residuals", problem.temporal_tv_residuals);
+  json->EndObject();
+}
+
+}  // namespace
+
 std::string SummaryJson(const ReconstructRequest& request, const ReconstructResult& result) {
-  const ReconstructionSummary& summary = result.reconstruction.summary;
-  const ReconstructionOptions& options = request.options;
-  const ObjectiveOptions& objective = options.objective;
+  const MethodResult& run = result.run;
+  const ReconstructionSummary& summary = run.reconstruction;
+  const ReconstructionOptions& options = request.method.reconstruction;
+  const bool iterative = IsIterative(request.method.method);
   JsonWriter json;
   json.BeginObject();
   json.Field("mode", ModeName(result.mode));
@@ -197,69 +290,33 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json.Field("height", result.height);
   json.Field("events", result.events);
   json.Field("event_frames", result.event_frames);
-  json.Field("latent_frames", result.reconstruction.video.num_frames());
+  json.Field("latent_frames", run.video.num_frames());
   json.Field("output_frames", result.output.num_frames());
   json.Key("solver").BeginObject();
-  json.Field("name", "ceres_lm");
-  json.Field("linear_solver", ceres::LinearSolverTypeToString(options.solver.linear_solver_type));
-  json.Field("preconditioner", ceres::PreconditionerTypeToString(options.solver.preconditioner_type));
-  json.Field("eta", options.solver.eta);
-  json.Field("max_iterations", options.solver.max_num_iterations);
-  json.Field("function_tolerance", options.solver.function_tolerance);
-  json.Field("threads", options.solver.num_threads);
-  json.Field("bounds", options.bound_intensities);
-  json.Field("initialization", result.initialization);
-  json.Field("termination", summary.solved ? ceres::TerminationTypeToString(
-                                                 summary.ceres.termination_type)
-                                           : "NOT_SOLVED");
-  json.Field("message", summary.solved ? summary.ceres.message : summary.skipped_reason);
-  if (summary.solved) {
-    // Where Ceres' time went (its own accounting).
-    json.Key("time_s").BeginObject();
-    json.Field("preprocessor", summary.ceres.preprocessor_time_in_seconds);
-    json.Field("residual_evaluation", summary.ceres.residual_evaluation_time_in_seconds);
-    json.Field("jacobian_evaluation", summary.ceres.jacobian_evaluation_time_in_seconds);
-    json.Field("linear_solver", summary.ceres.linear_solver_time_in_seconds);
-    json.Field("minimizer", summary.ceres.minimizer_time_in_seconds);
+  json.Field("name", run.method);
+  json.Field("message", run.message);
+  if (iterative) {
+    json.Field("initialization", run.initialization);
+    json.Field("bounds", options.bound_intensities);
+  }
+  if (request.method.method == Method::kCeresLm) WriteCeresLm(options, summary, &json);
+  if (!run.parameters.empty()) {
+    json.Key("parameters").BeginObject();
+    for (const BaselineParameter& parameter : run.parameters) {
+      json.Field(parameter.name.c_str(), parameter.value);
+    }
     json.EndObject();
-    json.Field("successful_steps", summary.ceres.num_successful_steps);
-    json.Field("unsuccessful_steps", summary.ceres.num_unsuccessful_steps);
   }
+  if (!run.threshold_source.empty()) json.Field("threshold_source", run.threshold_source);
   json.EndObject();
-  json.Key("model").BeginObject();
-  json.Field("event_model", EventModelName(objective.event_model.model));
-  json.Field("alpha", result.reconstruction.summary.model.alpha);
-  json.Field("alpha_derived", result.reconstruction.summary.alpha_derived);
-  if (result.reconstruction.summary.alpha_derived) {
-    json.Field("change_per_event", result.reconstruction.summary.model.change_per_event);
-    json.Field("change_measured_from_frames", result.reconstruction.summary.model.estimated_from_frames);
+  if (iterative) {
+    WriteModel(options.objective, summary, &json);
+    json.Field("solved", run.solved);
+    json.Field("iterations", run.iterations);
+    json.Field("initial_cost", run.initial_cost);
+    json.Field("final_cost", run.final_cost);
+    WriteProblem(options, summary.problem, &json);
   }
-  json.Field("frame_weight", objective.frame_weight);
-  json.Field("event_weight", objective.event_weight);
-  json.Field("spatial_tv_weight", objective.spatial_tv_weight);
-  json.Field("temporal_tv_weight", objective.temporal_tv_weight);
-  json.Field("spatial_tv", SpatialTvName(objective.spatial_tv));
-  json.Field("smoothing_scale", objective.smoothing_scale);
-  json.EndObject();
-  json.Field("solved", summary.solved);
-  json.Field("iterations", summary.iterations);
-  json.Field("initial_cost", summary.initial_cost);
-  json.Field("final_cost", summary.final_cost);
-  json.Key("pixels").BeginObject();
-  json.Field("active", summary.problem.active_pixels);
-  json.Field("skipped", summary.problem.skipped_pixels);
-  json.Field("activity_radius_px", options.activity_radius_px);
-  json.Field("merge_quiet_steps", options.merge_quiet_steps);
-  json.EndObject();
-  json.Key("problem").BeginObject();
-  json.Field("parameter_blocks", summary.problem.parameter_blocks);
-  json.Field("unknowns", summary.problem.variable_parameter_blocks);
-  json.Field("residual_blocks", summary.problem.residual_blocks());
-  json.Field("frame_residuals", summary.problem.frame_residuals);
-  json.Field("event_residuals", summary.problem.event_residuals);
-  json.Field("spatial_tv_residuals", summary.problem.spatial_tv_residuals);
-  json.Field("temporal_tv_residuals", summary.problem.temporal_tv_residuals);
-  json.EndObject();
   json.Key("time_s").BeginObject();
   json.Field("read", result.time.read_s);
   json.Field("bin", result.time.bin_s);
@@ -280,6 +337,21 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
     json.Field("baseline_psnr", truth.baseline_psnr);
     json.Field("baseline_ssim", truth.baseline_ssim);
     json.EndObject();
+  }
+  if (!run.checkpoints.empty()) {
+    json.Key("checkpoints").BeginArray();
+    for (const Checkpoint& checkpoint : run.checkpoints) {
+      json.BeginObject();
+      json.Field("iteration", checkpoint.iteration);
+      json.Field("time_s", checkpoint.time_s);
+      json.Field("cost", checkpoint.cost);
+      if (result.has_truth) {
+        json.Field("psnr", checkpoint.psnr);
+        json.Field("ssim", checkpoint.ssim);
+      }
+      json.EndObject();
+    }
+    json.EndArray();
   }
   json.EndObject();
   return json.str();

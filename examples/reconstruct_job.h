@@ -7,11 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "baselines/baseline_options.h"
 #include "core/video.h"
-#include "examples/initialization.h"
-#include "solver/reconstruction_options.h"
-#include "solver/reconstructor.h"
+#include "examples/method.h"
 #include "solver/scene.h"
 
 namespace evfs {
@@ -32,9 +29,12 @@ struct ReconstructRequest {
   double exposure_s = 0.0;  // deblur: exposure around the frame's timestamp when the data has none
   double fps = 0.0;         // > 0: resample the latent video to this uniform rate
   BinningOptions binning;
-  ReconstructionOptions options;  // objective.event_model.alpha <= 0: derive α from the data
-  Initialization initialization = Initialization::kBlend;
-  BaselineOptions baseline;  // the classical methods' parameters (initialisation, baselines)
+  /// The method and all its settings (objective.event_model.alpha <= 0: derive α from the data).
+  MethodOptions method;
+  /// Record cost (and PSNR/SSIM against --truth) at every iteration into summary.json.
+  bool checkpoints = false;
+  /// Sees every iteration of an iterative method (progress output); may be empty.
+  IterationCallback progress;
 };
 
 struct TruthScore {
@@ -54,10 +54,9 @@ struct ReconstructResult {
   int width = 0, height = 0;
   int64_t events = 0;  // events in the window
   int event_frames = 0;
-  Reconstruction reconstruction;  // latent video and solver summary
+  MethodResult run;               // latent video and what the method did
   Video output;                   // the latent video, or its resampling at request.fps
   Video baseline;                 // blend or copy on the latent timeline (the score's reference)
-  std::string initialization;     // what the solve started from ("blend", "integrate", "edi")
   bool has_truth = false;
   TruthScore truth;
   StageTimes time;

@@ -1,33 +1,76 @@
 #include "solver/reconstructor.h"
 
 #include <chrono>
+#include <memory>
 
 #include "core/error.h"
 
 namespace evfs {
 namespace {
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
+
+// Hands each Ceres iteration to an IterationCallback with the whole latent video: Ceres writes
+// the segment values (update_state_every_iteration), the layout spreads them over their voxels.
+class CallbackAdapter : public ceres::IterationCallback {
+ public:
+  CallbackAdapter(const evfs::IterationCallback& callback, const LatentLayout& layout,
+                  Video* latent)
+      : callback_(callback), layout_(layout), latent_(latent), start_(Clock::now()) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    const auto call_start = Clock::now();
+    layout_.Expand(latent_);
+    SolverIteration iteration;
+    iteration.iteration = summary.iteration;
+    iteration.cost = summary.cost;
+    iteration.elapsed_s = SecondsSince(start_) - time_in_callback_s_;
+    iteration.latent = latent_;
+    const bool go_on = callback_(iteration);
+    time_in_callback_s_ += SecondsSince(call_start);
+    return go_on ? ceres::SOLVER_CONTINUE : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+  }
+
+  double time_in_callback_s() const { return time_in_callback_s_; }
+
+ private:
+  const evfs::IterationCallback& callback_;
+  const LatentLayout& layout_;
+  Video* latent_;
+  const Clock::time_point start_;
+  double time_in_callback_s_ = 0.0;
+};
 
 }  // namespace
 
+ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOptions& options,
+                                  EventModelEstimate* model, bool* alpha_derived) {
+  ObjectiveOptions objective = options.objective;
+  EventModelParams& event_model = objective.event_model;
+  *alpha_derived = event_model.alpha <= 0.0;
+  if (*alpha_derived) {
+    *model = EstimateEventModel(scene, event_model, options.estimation);
+    event_model.alpha = model->alpha;
+  } else {
+    *model = EventModelEstimate();
+    model->alpha = event_model.alpha;
+    model->description = "alpha " + std::to_string(event_model.alpha) + " (given)";
+  }
+  return objective;
+}
+
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
-                           const Video* initial) {
+                           const Video* initial, const IterationCallback& callback) {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
   Reconstruction result;
   ReconstructionOptions solve_options = options;
-  EventModelParams& event_model = solve_options.objective.event_model;
-  if (event_model.alpha <= 0.0) {
-    result.summary.model = EstimateEventModel(scene, event_model, options.estimation);
-    result.summary.alpha_derived = true;
-    event_model.alpha = result.summary.model.alpha;
-  } else {
-    result.summary.model.alpha = event_model.alpha;
-    result.summary.model.description = "alpha " + std::to_string(event_model.alpha) + " (given)";
-  }
+  solve_options.objective =
+      ResolveObjective(scene, options, &result.summary.model, &result.summary.alpha_derived);
 
   if (initial != nullptr) {
     if (initial->num_frames() != scene.num_latent_frames() || initial->height() != scene.height ||
@@ -44,14 +87,21 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     return result;
   }
 
-  const auto build_start = std::chrono::steady_clock::now();
+  const auto build_start = Clock::now();
   const std::unique_ptr<BuiltProblem> built = ProblemBuilder(scene, solve_options).Build(&result.video);
   summary.build_time_s = SecondsSince(build_start);
   summary.problem = built->statistics();
 
-  const auto solve_start = std::chrono::steady_clock::now();
+  std::unique_ptr<CallbackAdapter> adapter;
+  if (callback) {
+    adapter = std::make_unique<CallbackAdapter>(callback, built->layout(), &result.video);
+    solve_options.solver.callbacks.push_back(adapter.get());
+    solve_options.solver.update_state_every_iteration = true;
+  }
+  const auto solve_start = Clock::now();
   ceres::Solve(solve_options.solver, &built->problem(), &summary.ceres);
-  summary.solve_time_s = SecondsSince(solve_start);
+  summary.solve_time_s =
+      SecondsSince(solve_start) - (adapter ? adapter->time_in_callback_s() : 0.0);
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;

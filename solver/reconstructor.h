@@ -8,6 +8,7 @@
 
 #include "core/video.h"
 #include "solver/event_model_estimation.h"
+#include "solver/iteration_callback.h"
 #include "solver/problem_builder.h"
 #include "solver/reconstruction_options.h"
 #include "solver/scene.h"
@@ -39,8 +40,15 @@ struct Reconstruction {
 /// InitializeLatentVideo(scene). Throws InvalidArgumentError for invalid options or an initial
 /// video of another shape. α <= 0 in the options is derived from the scene first. A scene
 /// without events is answered with its initialisation, without a solve.
+/// `callback`, when given, sees every Ceres iteration with the current latent video.
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
-                           const Video* initial = nullptr);
+                           const Video* initial = nullptr,
+                           const IterationCallback& callback = nullptr);
+
+/// options.objective with α derived from `scene` (EstimateEventModel) when it is <= 0; `model`
+/// says what was used and how, `alpha_derived` whether it was derived.
+ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOptions& options,
+                                  EventModelEstimate* model, bool* alpha_derived);
 
 }  // namespace evfs
 
