@@ -3,6 +3,7 @@
 #ifndef EVFS_CORE_TIME_H_
 #define EVFS_CORE_TIME_H_
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 
@@ -16,6 +17,11 @@ inline double NanosecondsToSeconds(int64_t t_ns) {
 
 inline int64_t SecondsToNanoseconds(double t_s) {
   return static_cast<int64_t>(std::llround(t_s * static_cast<double>(kNanosecondsPerSecond)));
+}
+
+/// Seconds elapsed since `start` on the monotonic clock, for stage and solve timings.
+inline double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace evfs

@@ -4,6 +4,7 @@
 
 #include "baselines/baseline.h"
 #include "core/error.h"
+#include "core/time.h"
 #include "core/metrics.h"
 #include "solver/activity_mask.h"
 #include "solver/problem_builder.h"
@@ -12,10 +13,6 @@ namespace evfs {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 struct MethodInfo {
   Method method;

@@ -27,10 +27,6 @@ constexpr double kMaxOutputFrames = 10000;
 // Longest --exposure_s: keeps t +- exposure / 2 far inside int64 nanoseconds.
 constexpr double kMaxExposureS = 3600.0;
 
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   const int count = static_cast<int>(source.frames().size());
   if (index < 0 || index >= count) {

@@ -12,15 +12,12 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/time.h"
 
 namespace evfs {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Solve time and the callback: measures the time since the solve started without the time
 // spent in the callback, and skips everything when there is no callback.

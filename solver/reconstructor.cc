@@ -4,15 +4,12 @@
 #include <memory>
 
 #include "core/error.h"
+#include "core/time.h"
 
 namespace evfs {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Hands each Ceres iteration to an IterationCallback with the whole latent video: Ceres writes
 // the segment values (update_state_every_iteration), the layout spreads them over their voxels.
