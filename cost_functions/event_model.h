@@ -50,19 +50,22 @@ inline void CheckEventModelParams(const EventModelParams& params) {
 ///
 /// The clamp at 0 is a guard for the optimiser stepping below 0 when intensities are not
 /// bounded to [0, 1]: log(x + b) would be NaN for x < -b and poison the whole solve. Below 0 the
-/// transform is flat (zero derivative), so such a step is neither rewarded nor fatal.
+/// transform is flat (zero derivative), so such a step is neither rewarded nor fatal. At exactly
+/// 0 the derivative is the right-hand one, 1/b: a bounded solve holds black pixels at 0 (a black
+/// first frame is copied to every latent frame), and a derivative of 0 there would leave the
+/// event term no gradient to brighten them with.
 template <typename T>
 T IntensityTransform(const T& intensity, const EventModelParams& params) {
   if (params.model == EventModel::kLinear) return intensity;
   using std::log;
-  const T clamped_intensity = intensity > T(0.0) ? intensity : T(0.0);
+  const T clamped_intensity = intensity >= T(0.0) ? intensity : T(0.0);
   return log(clamped_intensity + params.log_offset);
 }
 
-/// dg/dx, matching IntensityTransform (0 below the clamp), for hand-written Jacobians.
+/// dg/dx, matching IntensityTransform (0 below the clamp, 1/b at 0), for hand-written Jacobians.
 inline double IntensityTransformDerivative(double intensity, const EventModelParams& params) {
   if (params.model == EventModel::kLinear) return 1.0;
-  return intensity > 0.0 ? 1.0 / (intensity + params.log_offset) : 0.0;
+  return intensity >= 0.0 ? 1.0 / (intensity + params.log_offset) : 0.0;
 }
 
 /// Predicted event value of one latent step: c tanh(alpha (g(after) - g(before)) / c).

@@ -248,6 +248,8 @@ FirstOrderSummary SolveWithAdam(const Scene& scene, const ObjectiveOptions& obje
     }
     if (last) {
       summary.termination = "reached " + std::to_string(iteration) + " iterations";
+      // The schedule returns its last iterate, as the paper does; say so when that is worse.
+      if (cost > summary.initial_cost) summary.termination += ", with a higher cost than the start";
       break;
     }
     std::swap(current, next);

@@ -447,8 +447,8 @@ void FusedObjective::Impl::TimeSeriesTerms(int y, int begin, int end, const doub
         double* __restrict slope = scratch->transform_slope.data() + t * width;
         // IntensityTransform and its derivative: flat below 0.
         for (int x = begin; x < end; ++x) {
-          g[x] = (h[x] > 0.0 ? h[x] : 0.0) + offset;
-          slope[x] = h[x] > 0.0 ? 1.0 / (h[x] + offset) : 0.0;
+          g[x] = (h[x] >= 0.0 ? h[x] : 0.0) + offset;
+          slope[x] = h[x] >= 0.0 ? 1.0 / (h[x] + offset) : 0.0;
         }
         for (int x = begin; x < end; ++x) g[x] = std::log(g[x]);
       }

@@ -15,6 +15,11 @@ bool ObjectiveOptions::IsValid(std::string* error) const {
     *error = "term weights must be finite and non-negative";
     return false;
   }
+  if (frame_weight == 0.0 && event_weight == 0.0 && spatial_tv_weight == 0.0 &&
+      temporal_tv_weight == 0.0) {
+    *error = "at least one term weight must be positive";
+    return false;
+  }
   if (!(std::isfinite(smoothing_scale) && smoothing_scale > 0.0)) {
     *error = "smoothing_scale must be positive";
     return false;
@@ -91,6 +96,11 @@ ReconstructionOptions::ReconstructionOptions() : solver(DefaultSolverOptions()) 
 
 bool ReconstructionOptions::IsValid(std::string* error) const {
   if (!objective.IsValid(error) || !estimation.IsValid(error)) return false;
+  if (bound_intensities && solver.minimizer_type == ceres::LINE_SEARCH) {
+    *error = "Ceres' line-search minimiser cannot keep intensities in [0, 1]: turn the bounds "
+             "off or use the trust-region minimiser";
+    return false;
+  }
   return solver.IsValid(error);
 }
 

@@ -1,5 +1,6 @@
 #include "solver/reconstructor.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
@@ -88,6 +89,10 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   const std::unique_ptr<BuiltProblem> built = ProblemBuilder(scene, solve_options).Build(&result.video);
   summary.build_time_s = SecondsSince(build_start);
   summary.problem = built->statistics();
+  if (summary.problem.variable_parameter_blocks == 0) {
+    summary.skipped_reason = "no unknowns: no pixel is active";
+    return result;
+  }
 
   std::unique_ptr<CallbackAdapter> adapter;
   if (callback) {
@@ -99,10 +104,13 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   ceres::Solve(solve_options.solver, &built->problem(), &summary.ceres);
   summary.solve_time_s =
       SecondsSince(solve_start) - (adapter ? adapter->time_in_callback_s() : 0.0);
+  if (summary.ceres.termination_type == ceres::FAILURE) {
+    throw InvalidArgumentError("the solve failed: " + summary.ceres.message);
+  }
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
-  summary.iterations = static_cast<int>(summary.ceres.iterations.size()) - 1;
+  summary.iterations = std::max(0, static_cast<int>(summary.ceres.iterations.size()) - 1);
   built->layout().Expand(&result.video);
   return result;
 }

@@ -47,6 +47,17 @@ TEST(EventModel, LogGuardClampsNegativeIntensities) {
   EXPECT_EQ(IntensityTransformDerivative(-0.5, LogParams()), 0.0);
 }
 
+TEST(EventModel, LogGuardKeepsTheSlopeAtZero) {
+  // Regression: the clamp took x = 0 itself to the flat side, so a bounded solve starting from
+  // a black frame had no event gradient at all and stopped after 0 iterations
+  // (tests/stress, black_start_prediction_log).
+  using Jet = ceres::Jet<double, 1>;
+  const Jet transformed = IntensityTransform(Jet(0.0, 0), LogParams());
+  EXPECT_NEAR(transformed.a, std::log(0.1), kNominalTolerance);
+  EXPECT_NEAR(transformed.v[0], 1.0 / 0.1, kNominalTolerance);
+  EXPECT_NEAR(IntensityTransformDerivative(0.0, LogParams()), 1.0 / 0.1, kNominalTolerance);
+}
+
 TEST(EventModel, DerivativeMatchesAutoDiff) {
   using Jet = ceres::Jet<double, 1>;
   for (const EventModelParams& params : {EventModelParams(), LogParams()}) {
