@@ -69,7 +69,7 @@ DEFINE_int32(max_latent_frames, evfs::BinningOptions().max_latent_frames, "auto 
              "stacked equal-time binning with this many frames.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "auto binning: most pixels x latent frames (at least 4 steps are kept); bounds "
-             "memory on large sensors (Ceres needs ~1 GB per million).");
+             "memory and time on large sensors.");
 DEFINE_int32(stacked_frames, evfs::BinningOptions().stacked.num_frames, "stacked binning: number of event frames.");
 // Objective.
 DEFINE_double(frame_weight, evfs::ObjectiveOptions().frame_weight, "Weight of the frame term.");
