@@ -3,7 +3,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build run test test-sanitize bench clean
+.PHONY: all deps build run test test-sanitize bench clean fuzz
 
 all: build
 
@@ -25,6 +25,30 @@ test: build
 test-sanitize: deps
 	@$(MAKE) --no-print-directory test BUILD_DIR=build-asan \
 	  CMAKE_FLAGS="-DEVFS_SANITIZE=ON -DEVFS_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo"
+
+# libFuzzer targets (clang, ASan+UBSan) in build-fuzz/, each run for FUZZ_SECONDS from seeds
+# cut from the shared data; stops at the first finding, whose input is left in
+# build-fuzz/tests/fuzz/findings/. libhdf5 itself hangs or runs out of memory on some corrupt
+# files (README.md, Robustness), so the HDF5 target runs in fork mode, which records those in
+# findings/ and goes on; a crash still stops it.
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS = event_text_fuzzer frame_list_fuzzer hdf5_io_fuzzer
+FUZZ_DIR = build-fuzz/tests/fuzz
+
+fuzz:
+	@bash scripts/install-deps.sh --fuzz
+	@cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
+	  -DCMAKE_CXX_COMPILER=clang++ -DEVFS_FUZZ=ON -DEVFS_BUILD_BENCHMARKS=OFF > /dev/null
+	@cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS) fuzz_seeds
+	@for target in $(FUZZ_TARGETS); do \
+	  name=$${target%_fuzzer}; \
+	  mkdir -p $(FUZZ_DIR)/corpus/$$name $(FUZZ_DIR)/findings; \
+	  mode=; if [ $$name = hdf5_io ]; then mode=-fork=1; fi; \
+	  echo "fuzz: $$target for $(FUZZ_SECONDS) s"; \
+	  $(FUZZ_DIR)/$$target $$mode -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
+	    -print_final_stats=1 -artifact_prefix=$(FUZZ_DIR)/findings/$$name- \
+	    $(FUZZ_DIR)/corpus/$$name $(FUZZ_DIR)/seeds/$$name || exit 1; \
+	done
 
 bench: build
 	bash benchmarks/run_all.sh $(BUILD_DIR)

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "io/decimal_seconds.h"
+#include "io/message_excerpt.h"
 #include "io/text_file_writer.h"
 
 namespace evfs {
@@ -134,7 +136,10 @@ inline bool EventTextReader::ParseCanonicalLine(const char** line, uint32_t x_li
 }
 
 EventTextReader::EventTextReader(const std::string& path, int width, int height)
-    : file_(path), width_(width), height_(height) {
+    : EventTextReader(MappedFile(path), width, height) {}
+
+EventTextReader::EventTextReader(MappedFile file, int width, int height)
+    : file_(std::move(file)), width_(width), height_(height) {
   const char* data = file_.data();
   size_t size = file_.size();
   while (size > 0 && data[size - 1] != '\n') --size;
@@ -157,6 +162,7 @@ void EventTextReader::FailPolarity(size_t line_offset, const char* polarity_begi
   const char* token_end = polarity_begin;
   while (!IsBlank(*token_end) && !IsLineEnd(*token_end)) ++token_end;
   const std::string token(polarity_begin, token_end);
+  const std::string excerpt = MessageExcerpt(token);
   if (token == "1" || token == "0" || token == "-1") {
     Fail(InputError::Kind::kMalformed, line_offset,
          "expected " + std::to_string(kFieldCount) + " fields 't x y p', found more");
@@ -165,10 +171,11 @@ void EventTextReader::FailPolarity(size_t line_offset, const char* polarity_begi
   const bool is_integer =
       token.size() > sign && std::all_of(token.begin() + sign, token.end(), internal::IsDigit);
   if (is_integer) {
-    Fail(InputError::Kind::kOutOfRange, line_offset, "polarity must be -1, 0 or 1, found " + token);
+    Fail(InputError::Kind::kOutOfRange, line_offset,
+         "polarity must be -1, 0 or 1, found " + excerpt);
   }
   Fail(InputError::Kind::kMalformed, line_offset,
-       "field 'p': expected -1, 0 or 1, found '" + token + "'");
+       "field 'p': expected -1, 0 or 1, found '" + excerpt + "'");
 }
 
 const char* EventTextReader::ParseLine(const char* p, size_t line_offset, uint32_t x_limit,
@@ -216,7 +223,7 @@ const char* EventTextReader::ParseLine(const char* p, size_t line_offset, uint32
     // More than 9 digits could overflow `value`; such a number is out of range anyway.
     if (p - digits > 9 || value >= limits[i]) {
       Fail(InputError::Kind::kOutOfRange, line_offset,
-           std::string(kFieldNames[field]) + " = " + std::string(digits, p) +
+           std::string(kFieldNames[field]) + " = " + MessageExcerpt(digits, p) +
                " is outside the sensor (" + kFieldNames[field] + " must be below " +
                std::to_string(limits[i]) + ")");
     }

@@ -24,6 +24,8 @@ class EventTextReader {
   /// against the uint16 range, and the streams returned are sized to the largest coordinate
   /// they hold plus one. Throws InputError(kMissingFile).
   explicit EventTextReader(const std::string& path, int width = 0, int height = 0);
+  /// Reads the bytes of `file` (see MappedFile::FromMemory), which it keeps.
+  explicit EventTextReader(MappedFile file, int width = 0, int height = 0);
 
   const std::string& path() const { return file_.path(); }
 

@@ -8,10 +8,14 @@
 
 #include "core/error.h"
 #include "io/decimal_seconds.h"
+#include "io/message_excerpt.h"
 #include "io/text_file_writer.h"
 
 namespace evfs {
 namespace {
+
+// PATH_MAX on Linux: the system opens no longer path.
+constexpr size_t kMaxImagePathBytes = 4096;
 
 bool IsBlank(char c) { return c == ' ' || c == '\t'; }
 
@@ -23,15 +27,20 @@ std::string Trim(const std::string& text) {
   return text.substr(begin, end - begin);
 }
 
-// Calls `visit(line_number, content)` for every line that is neither blank nor a comment, with
-// the content trimmed of surrounding blanks and a trailing '\r'.
-void ForEachContentLine(const std::string& path,
-                        const std::function<void(int64_t, const std::string&)>& visit) {
+// Opens `path`, or throws InputError(kMissingFile).
+std::ifstream OpenForReading(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);
   if (!stream) {
     throw InputError(InputError::Kind::kMissingFile, path, 0,
                      std::string("cannot read the file: ") + std::strerror(errno));
   }
+  return stream;
+}
+
+// Calls `visit(line_number, content)` for every line that is neither blank nor a comment, with
+// the content trimmed of surrounding blanks and a trailing '\r'.
+void ForEachContentLine(std::istream& stream,
+                        const std::function<void(int64_t, const std::string&)>& visit) {
   std::string line;
   for (int64_t line_number = 1; std::getline(stream, line); ++line_number) {
     const std::string content = Trim(line);
@@ -51,7 +60,8 @@ int64_t ParseSecondsField(const std::string& token, const std::string& field,
   }
   if (status != DecimalStatus::kOk) {
     throw InputError(InputError::Kind::kMalformed, path, line_number,
-                     "field '" + field + "' = '" + token + "': " + DescribeDecimalStatus(status));
+                     "field '" + field + "' = '" + MessageExcerpt(token) +
+                         "': " + DescribeDecimalStatus(status));
   }
   return t_ns;
 }
@@ -78,26 +88,47 @@ bool SplitLast(const std::string& content, std::string* rest, std::string* last)
 
 }  // namespace
 
+std::string ImagePathProblem(const std::string& path) {
+  if (HasControlCharacter(path)) {
+    return "image path '" + MessageExcerpt(path) + "' holds a control character";
+  }
+  if (path.size() > kMaxImagePathBytes) {
+    return "image path '" + MessageExcerpt(path) + "' is longer than " +
+           std::to_string(kMaxImagePathBytes) + " bytes";
+  }
+  return "";
+}
+
 std::vector<FrameInfo> ReadFrameList(const std::string& images_txt) {
+  std::ifstream stream = OpenForReading(images_txt);
+  return ReadFrameList(stream, images_txt);
+}
+
+std::vector<FrameInfo> ReadFrameList(std::istream& stream, const std::string& images_txt) {
   std::vector<FrameInfo> frames;
   std::map<std::string, int64_t> line_of_path;
-  ForEachContentLine(images_txt, [&](int64_t line_number, const std::string& content) {
+  ForEachContentLine(stream, [&](int64_t line_number, const std::string& content) {
     FrameInfo frame;
     std::string t_token;
     if (!SplitFirst(content, &t_token, &frame.path) || frame.path.empty()) {
       throw InputError(InputError::Kind::kMalformed, images_txt, line_number,
-                       "expected 't path', found '" + content + "'");
+                       "expected 't path', found '" + MessageExcerpt(content) + "'");
+    }
+    const std::string path_problem = ImagePathProblem(frame.path);
+    if (!path_problem.empty()) {
+      throw InputError(InputError::Kind::kMalformed, images_txt, line_number, path_problem);
     }
     frame.t_ns = ParseSecondsField(t_token, "t", images_txt, line_number);
     if (!frames.empty() && frame.t_ns <= frames.back().t_ns) {
       throw InputError(InputError::Kind::kNotMonotonic, images_txt, line_number,
-                       "frame timestamps must increase strictly: " + t_token + " s follows " +
+                       "frame timestamps must increase strictly: " +
+                           FormatDecimalSeconds(frame.t_ns, kMaxFractionDigits) + " s follows " +
                            FormatDecimalSeconds(frames.back().t_ns, kMaxFractionDigits) + " s");
     }
     const auto inserted = line_of_path.emplace(frame.path, line_number);
     if (!inserted.second) {
       throw InputError(InputError::Kind::kMalformed, images_txt, line_number,
-                       "path '" + frame.path + "' is already listed on line " +
+                       "path '" + MessageExcerpt(frame.path) + "' is already listed on line " +
                            std::to_string(inserted.first->second));
     }
     frames.push_back(std::move(frame));
@@ -106,10 +137,16 @@ std::vector<FrameInfo> ReadFrameList(const std::string& images_txt) {
 }
 
 void ReadExposures(const std::string& exposures_txt, std::vector<FrameInfo>* frames) {
+  std::ifstream stream = OpenForReading(exposures_txt);
+  ReadExposures(stream, exposures_txt, frames);
+}
+
+void ReadExposures(std::istream& stream, const std::string& exposures_txt,
+                   std::vector<FrameInfo>* frames) {
   std::map<std::string, FrameInfo*> frame_of_path;
   for (FrameInfo& frame : *frames) frame_of_path[frame.path] = &frame;
   std::map<std::string, int64_t> line_of_path;
-  ForEachContentLine(exposures_txt, [&](int64_t line_number, const std::string& content) {
+  ForEachContentLine(stream, [&](int64_t line_number, const std::string& content) {
     std::string rest;
     std::string path;
     std::string begin_token;
@@ -117,24 +154,25 @@ void ReadExposures(const std::string& exposures_txt, std::vector<FrameInfo>* fra
     if (!SplitLast(content, &rest, &end_token) || !SplitLast(rest, &path, &begin_token) ||
         path.empty()) {
       throw InputError(InputError::Kind::kMalformed, exposures_txt, line_number,
-                       "expected 'path t_start t_end', found '" + content + "'");
+                       "expected 'path t_start t_end', found '" + MessageExcerpt(content) + "'");
     }
     const int64_t begin_ns = ParseSecondsField(begin_token, "t_start", exposures_txt, line_number);
     const int64_t end_ns = ParseSecondsField(end_token, "t_end", exposures_txt, line_number);
     if (end_ns <= begin_ns) {
       throw InputError(InputError::Kind::kOutOfRange, exposures_txt, line_number,
-                       "exposure must end after it starts (t_start " + begin_token + " s, t_end " +
-                           end_token + " s)");
+                       "exposure must end after it starts (t_start " +
+                           FormatDecimalSeconds(begin_ns, kMaxFractionDigits) + " s, t_end " +
+                           FormatDecimalSeconds(end_ns, kMaxFractionDigits) + " s)");
     }
     const auto frame = frame_of_path.find(path);
     if (frame == frame_of_path.end()) {
       throw InputError(InputError::Kind::kMalformed, exposures_txt, line_number,
-                       "image '" + path + "' is not listed in images.txt");
+                       "image '" + MessageExcerpt(path) + "' is not listed in images.txt");
     }
     const auto inserted = line_of_path.emplace(path, line_number);
     if (!inserted.second) {
       throw InputError(InputError::Kind::kMalformed, exposures_txt, line_number,
-                       "image '" + path + "' already has an exposure on line " +
+                       "image '" + MessageExcerpt(path) + "' already has an exposure on line " +
                            std::to_string(inserted.first->second));
     }
     frame->second->has_exposure = true;

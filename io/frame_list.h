@@ -4,6 +4,7 @@
 #ifndef EVFS_IO_FRAME_LIST_H_
 #define EVFS_IO_FRAME_LIST_H_
 
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -12,12 +13,21 @@
 namespace evfs {
 
 /// Reads images.txt. Timestamps must increase strictly (kNotMonotonic otherwise) and paths must
-/// be unique. Throws InputError naming the file and line.
+/// be unique and usable (ImagePathProblem). Throws InputError naming the file and line.
 std::vector<FrameInfo> ReadFrameList(const std::string& images_txt);
+/// The same from `stream`, named `images_txt` in errors (for text already in memory).
+std::vector<FrameInfo> ReadFrameList(std::istream& stream, const std::string& images_txt);
+
+/// Why `path` cannot name an image file (it holds a control character, or is longer than any
+/// path the system opens), or "" when it can.
+std::string ImagePathProblem(const std::string& path);
 
 /// Reads exposures.txt and sets the exposure of the frames it names (matched by path). A path
 /// not in `frames`, a path named twice, or t_end <= t_start is an InputError.
 void ReadExposures(const std::string& exposures_txt, std::vector<FrameInfo>* frames);
+/// The same from `stream`, named `exposures_txt` in errors.
+void ReadExposures(std::istream& stream, const std::string& exposures_txt,
+                   std::vector<FrameInfo>* frames);
 
 /// Writes images.txt with the fewest fractional digits that keep every timestamp exact.
 void WriteFrameList(const std::string& images_txt, const std::vector<FrameInfo>& frames);

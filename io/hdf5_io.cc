@@ -11,7 +11,9 @@
 
 #include "core/error.h"
 #include "core/time.h"
+#include "io/frame_list.h"
 #include "io/image_io.h"
+#include "io/message_excerpt.h"
 
 namespace evfs {
 namespace {
@@ -27,6 +29,9 @@ constexpr char kExposureStart[] = "exposure_start";
 constexpr char kExposureEnd[] = "exposure_end";
 constexpr char kPath[] = "path";
 constexpr char kTsUnit[] = "ts_unit";
+// Image dataset names appear in error messages, which must stay one short line; tools write
+// names like image000000000.
+constexpr size_t kMaxImageNameBytes = 64;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
 
@@ -144,6 +149,31 @@ std::vector<hsize_t> Dimensions(const H5Context& h5, hid_t dataset, const std::s
   std::vector<hsize_t> dims(static_cast<size_t>(rank));
   H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
   return dims;
+}
+
+// HDF5 reads fill values wherever a dataset's storage was never written, so a file whose writer
+// stopped early would read as zeros, and a corrupt extent could claim terabytes of them. Throws
+// unless the file stores what `dataset` (of extent `dims`) declares: some data at all, and all
+// of it when it is not compressed (a compressed size says nothing about the extent).
+void CheckStored(const H5Context& h5, hid_t dataset, const std::string& name,
+                 const std::vector<hsize_t>& dims) {
+  const Handle type = h5.Check(H5Dget_type(dataset), H5Tclose, "unreadable type of " + name);
+  const Handle properties =
+      h5.Check(H5Dget_create_plist(dataset), H5Pclose, "unreadable properties of " + name);
+  // In long double: a corrupt extent can overflow 64 bits.
+  long double declared_bytes = static_cast<long double>(H5Tget_size(type.get()));
+  for (const hsize_t dim : dims) declared_bytes *= static_cast<long double>(dim);
+  if (declared_bytes == 0) return;
+  const hsize_t stored_bytes = H5Dget_storage_size(dataset);
+  const bool compressed = H5Pget_nfilters(properties.get()) > 0;
+  if (stored_bytes == 0 || (!compressed && stored_bytes < declared_bytes)) {
+    std::string extent;
+    for (const hsize_t dim : dims) extent += (extent.empty() ? "" : "x") + std::to_string(dim);
+    h5.Fail(InputError::Kind::kMalformed,
+            name + " declares " + extent + " " + std::to_string(H5Tget_size(type.get())) +
+                "-byte values but the file stores " + std::to_string(stored_bytes) +
+                " bytes of them (truncated or incomplete file?)");
+  }
 }
 
 // Reads elements [first, first + count) of a 1-D dataset, converted to `memory_type`.
@@ -298,6 +328,7 @@ class Hdf5DataSource::File {
                                  "cannot open dataset " + full);
       const std::vector<hsize_t> dims = Dimensions(h5_, dataset.get(), full);
       if (dims.size() != 1) h5_.Fail(InputError::Kind::kMalformed, full + " must be 1-D");
+      CheckStored(h5_, dataset.get(), full, dims);
       if (name == std::string("xs")) num_events_ = static_cast<int64_t>(dims[0]);
       if (static_cast<int64_t>(dims[0]) != num_events_) {
         h5_.Fail(InputError::Kind::kMalformed, full + " holds " + std::to_string(dims[0]) +
@@ -325,8 +356,9 @@ class Hdf5DataSource::File {
       } else if (unit == "us") {
         ts_unit_ns_ = 1000;
       } else {
-        h5_.Fail(InputError::Kind::kMalformed,
-                 "events/ts attribute ts_unit is '" + unit + "', expected 'ns' or 'us'");
+        h5_.Fail(
+            InputError::Kind::kMalformed,
+            "events/ts attribute ts_unit is '" + MessageExcerpt(unit) + "', expected 'ns' or 'us'");
       }
     }
 
@@ -411,11 +443,18 @@ class Hdf5DataSource::File {
       H5Lget_name_by_idx(group.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, &name[0], name.size(),
                          H5P_DEFAULT);
       name.resize(static_cast<size_t>(length));
+      if (HasControlCharacter(name) || name.size() > kMaxImageNameBytes) {
+        h5_.Fail(InputError::Kind::kMalformed,
+                 "images/" + MessageExcerpt(name) +
+                     ": expected a printable dataset name of at most " +
+                     std::to_string(kMaxImageNameBytes) + " bytes");
+      }
       const std::string full = std::string(kImagesGroup) + "/" + name;
       const Handle dataset = h5_.Check(H5Dopen2(group.get(), name.c_str(), H5P_DEFAULT), H5Dclose,
                                        full + " is not a dataset");
       const std::vector<hsize_t> dims = Dimensions(h5_, dataset.get(), full);
       if (dims.size() != 2) h5_.Fail(InputError::Kind::kMalformed, full + " must be a 2-D image");
+      CheckStored(h5_, dataset.get(), full, dims);
       if (width_ == 0 || height_ == 0) {
         height_ = static_cast<int>(dims[0]);
         width_ = static_cast<int>(dims[1]);
@@ -425,6 +464,8 @@ class Hdf5DataSource::File {
       frame.path = HasAttribute(dataset.get(), kPath)
                        ? ReadStringAttribute(h5_, dataset.get(), kPath, full)
                        : full;
+      const std::string path_problem = ImagePathProblem(frame.path);
+      if (!path_problem.empty()) h5_.Fail(InputError::Kind::kMalformed, full + ": " + path_problem);
       frame.has_exposure =
           HasAttribute(dataset.get(), kExposureStart) || HasAttribute(dataset.get(), kExposureEnd);
       if (frame.has_exposure) {

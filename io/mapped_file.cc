@@ -46,6 +46,15 @@ MappedFile::MappedFile(const std::string& path) : path_(path) {
   void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd.get(), 0);
   if (mapped == MAP_FAILED) ThrowCannotOpen(path, std::strerror(errno));
   data_ = static_cast<const char*>(mapped);
+  mapped_ = true;
+}
+
+MappedFile MappedFile::FromMemory(std::string path, const char* data, size_t size) {
+  MappedFile file;
+  file.path_ = std::move(path);
+  file.data_ = data;
+  file.size_ = size;
+  return file;
 }
 
 MappedFile::~MappedFile() { Unmap(); }
@@ -53,7 +62,8 @@ MappedFile::~MappedFile() { Unmap(); }
 MappedFile::MappedFile(MappedFile&& other) noexcept
     : path_(std::move(other.path_)),
       data_(std::exchange(other.data_, nullptr)),
-      size_(std::exchange(other.size_, 0)) {}
+      size_(std::exchange(other.size_, 0)),
+      mapped_(std::exchange(other.mapped_, false)) {}
 
 MappedFile& MappedFile::operator=(MappedFile&& other) noexcept {
   if (this != &other) {
@@ -61,14 +71,16 @@ MappedFile& MappedFile::operator=(MappedFile&& other) noexcept {
     path_ = std::move(other.path_);
     data_ = std::exchange(other.data_, nullptr);
     size_ = std::exchange(other.size_, 0);
+    mapped_ = std::exchange(other.mapped_, false);
   }
   return *this;
 }
 
 void MappedFile::Unmap() {
-  if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
+  if (mapped_) ::munmap(const_cast<char*>(data_), size_);
   data_ = nullptr;
   size_ = 0;
+  mapped_ = false;
 }
 
 }  // namespace evfs

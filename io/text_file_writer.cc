@@ -13,7 +13,6 @@ TextFileWriter::TextFileWriter(const std::string& path)
     throw InputError(InputError::Kind::kUnwritable, path, 0,
                      std::string("cannot create the file: ") + std::strerror(errno));
   }
-  buffer_.reserve(kFlushBytes + kMaxLineBytes);
 }
 
 TextFileWriter::~TextFileWriter() {

@@ -45,6 +45,8 @@ class TextFileWriter {
 
   std::string path_;
   std::FILE* file_;
+  // Grows as written up to about kFlushBytes; not reserved up front, so that a small file
+  // (images.txt, timestamps.txt) costs no megabyte allocation.
   std::string buffer_;
   size_t reserved_at_ = 0;
 };

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages evfs needs to build, test and benchmark.
 # Idempotent: when everything is present it only runs dpkg-query and exits.
+# With --fuzz it also installs clang and its libFuzzer runtime (for `make fuzz` only).
 set -euo pipefail
 
 packages=(
@@ -8,6 +9,9 @@ packages=(
   libceres-dev libeigen3-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
+if [ "${1:-}" = "--fuzz" ]; then
+  packages+=(clang libclang-rt-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

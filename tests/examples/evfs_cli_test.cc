@@ -12,7 +12,11 @@
 
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
+#include "io/data_source.h"
+#include "io/hdf5_io.h"
+#include "io/image_io.h"
 #include "io/text_folder.h"
+#include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace evfs {
@@ -22,11 +26,22 @@ namespace fs = std::filesystem;
 
 struct CommandResult {
   int exit_code = -1;
-  std::string output;  // stdout and stderr together
+  std::string output;  // stdout, then stderr
+  std::string errors;  // stderr alone
 };
 
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 CommandResult RunEvfs(const std::string& arguments) {
-  const std::string command = std::string(EVFS_BINARY) + " " + arguments + " 2>&1";
+  fs::create_directories(EVFS_TEST_TMP_DIR);
+  const fs::path stderr_file = fs::path(EVFS_TEST_TMP_DIR) / "stderr.txt";
+  const std::string command =
+      std::string(EVFS_BINARY) + " " + arguments + " 2>" + stderr_file.string();
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
@@ -34,14 +49,29 @@ CommandResult RunEvfs(const std::string& arguments) {
   while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.errors = ReadFile(stderr_file);
+  result.output += result.errors;
   return result;
 }
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+// Longest error line accepted: the paths it names plus a short explanation, even when the input
+// held a megabyte line (input is quoted cut short, io/message_excerpt.h).
+constexpr size_t kMaxErrorLineBytes = 600;
+
+// A user error: exit status 2, exactly one short line on stderr holding `expected` (the file
+// and line it names, or the flag), and nothing under `out` or beside it (no partial folder).
+void ExpectUserError(const CommandResult& result, const std::string& expected,
+                     const fs::path& out) {
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
+  EXPECT_EQ(result.errors.back(), '\n') << result.errors;
+  EXPECT_LT(result.errors.size(), kMaxErrorLineBytes) << result.errors.substr(0, 1000);
+  EXPECT_NE(result.errors.find(expected), std::string::npos) << result.errors;
+  EXPECT_FALSE(fs::exists(out)) << out;
+  for (const auto& entry : fs::directory_iterator(out.parent_path())) {
+    EXPECT_NE(entry.path().filename().string().rfind(out.filename().string() + ".partial", 0), 0u)
+        << "left behind: " << entry.path();
+  }
 }
 
 // A small synthetic recording written as a data folder: 5 frames 5 ms apart, events simulated
@@ -112,8 +142,8 @@ TEST(EvfsCli, ConvertRoundTripIsByteIdentical) {
   const std::string scratch = testing::ScratchDir("convert");
   const std::string source = data + "/shapes_rotation_13_20";
   ASSERT_EQ(RunEvfs("convert --data=" + source + " --out=" + scratch + "/shapes.h5").exit_code, 0);
-  ASSERT_EQ(RunEvfs("convert --data=" + scratch + "/shapes.h5 --out=" + scratch + "/back").exit_code,
-            0);
+  ASSERT_EQ(
+      RunEvfs("convert --data=" + scratch + "/shapes.h5 --out=" + scratch + "/back").exit_code, 0);
   EXPECT_EQ(ReadFile(scratch + "/back/events.txt"), ReadFile(source + "/events.txt"));
   EXPECT_EQ(ReadFile(scratch + "/back/images.txt"), ReadFile(source + "/images.txt"));
 }
@@ -122,8 +152,9 @@ TEST(EvfsCli, ReconstructWritesFramesTimestampsAndSummary) {
   const std::string scratch = testing::ScratchDir("reconstruct");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string out = scratch + "/out";
-  const CommandResult run = RunEvfs("reconstruct --data=" + data +
-                                    " --mode=interpolate --first=0 --last=2 --truth=1 --out=" + out);
+  const CommandResult run =
+      RunEvfs("reconstruct --data=" + data +
+              " --mode=interpolate --first=0 --last=2 --truth=1 --out=" + out);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::string summary = ReadFile(out + "/summary.json");
   EXPECT_NE(summary.find("\"mode\": \"interpolate\""), std::string::npos) << summary;
@@ -137,9 +168,9 @@ TEST(EvfsCli, ReconstructWritesFramesTimestampsAndSummary) {
   EXPECT_EQ(pngs, lines);
 
   // Resampled to a uniform rate: 10 ms at 1 kHz gives 11 frames.
-  const CommandResult resampled = RunEvfs("reconstruct --data=" + data +
-                                          " --mode=interpolate --first=0 --last=2 --fps=1000 --out=" +
-                                          out + "_1khz");
+  const CommandResult resampled =
+      RunEvfs("reconstruct --data=" + data +
+              " --mode=interpolate --first=0 --last=2 --fps=1000 --out=" + out + "_1khz");
   ASSERT_EQ(resampled.exit_code, 0) << resampled.output;
   const std::string uniform = ReadFile(out + "_1khz/timestamps.txt");
   EXPECT_EQ(std::count(uniform.begin(), uniform.end(), '\n'), 11);
@@ -162,13 +193,219 @@ TEST(EvfsCli, UserErrorsExitWithStatus2AndLeaveNoOutput) {
       {"reconstruct --data=" + data + " --mode=deblur --first=1 --out=" + out, "exposure"},
       {"reconstruct --data=" + data + " --mode=predict --first=0 --spatial_tv=round --out=" + out,
        "--spatial_tv"},
+      // Values that used to overflow the nanosecond timeline or resample forever.
+      {"reconstruct --data=" + data + " --mode=deblur --first=1 --exposure_s=1e30 --out=" + out,
+       "--exposure_s must be between 0 and 3600 seconds"},
+      {"reconstruct --data=" + data + " --mode=predict --first=0 --fps=1e300 --out=" + out,
+       "--fps would resample"},
   };
   for (const auto& c : cases) {
-    const CommandResult result = RunEvfs(c.arguments);
-    EXPECT_EQ(result.exit_code, 2) << c.arguments << "\n" << result.output;
-    EXPECT_NE(result.output.find(c.expected), std::string::npos) << c.arguments << "\n"
-                                                                 << result.output;
-    EXPECT_FALSE(fs::exists(out)) << c.arguments;
+    SCOPED_TRACE(c.arguments);
+    ExpectUserError(RunEvfs(c.arguments), c.expected, out);
+  }
+}
+
+// A tiny recording whose every line is known: two 16x12 frames 100 ms apart and ten events
+// between them, on lines 1..10 of events.txt (t = 1.00, 1.01, ..., 1.09 s).
+constexpr int kTinyWidth = 16;
+constexpr int kTinyHeight = 12;
+
+std::string TinyEventLines() {
+  std::string lines;
+  for (int i = 0; i < 10; ++i) {
+    lines += "1.0" + std::to_string(i) + " " + std::to_string(i) + " " + std::to_string(i) + " " +
+             (i % 2 ? "1" : "0") + "\n";
+  }
+  return lines;
+}
+
+fs::path WriteTinyFolder(const fs::path& folder) {
+  fs::create_directories(folder / "images");
+  WriteGreyPng8((folder / "images/a.png").string(),
+                testing::MakeRandomImage(1, kTinyWidth, kTinyHeight, 8));
+  WriteGreyPng8((folder / "images/b.png").string(),
+                testing::MakeRandomImage(2, kTinyWidth, kTinyHeight, 8));
+  testing::WriteFile((folder / "images.txt").string(), "1.0 images/a.png\n1.1 images/b.png\n");
+  testing::WriteFile((folder / "events.txt").string(), TinyEventLines());
+  return folder;
+}
+
+// `lines` with line `number` (1-based) replaced by `replacement`.
+std::string ReplaceLine(const std::string& lines, int number, const std::string& replacement) {
+  std::istringstream in(lines);
+  std::string result;
+  std::string line;
+  for (int i = 1; std::getline(in, line); ++i) result += (i == number ? replacement : line) + "\n";
+  return result;
+}
+
+// Every kind of bad data file: exit status 2, one line naming the file (and line), no output.
+TEST(EvfsCli, BadDataFilesAreUserErrors) {
+  const fs::path scratch = testing::ScratchDir("bad_files");
+  const fs::path out = scratch / "out";
+  const std::string events = TinyEventLines();
+  const std::string megabyte(1 << 20, '9');
+  const struct {
+    std::string name;
+    std::string file;     // relative to the folder
+    std::string content;  // written over it ("" with remove: deleted)
+    bool remove;
+    std::string mode;  // and frame flags
+    std::string expected;
+  } cases[] = {
+      {"field_count", "events.txt", ReplaceLine(events, 3, "1.02 2 2"), false, "predict --first=0",
+       "events.txt:3: expected 4 fields"},
+      {"not_a_number", "events.txt", ReplaceLine(events, 3, "1.02 two 2 1"), false,
+       "predict --first=0", "events.txt:3: field 'x'"},
+      {"nan", "events.txt", ReplaceLine(events, 3, "nan 2 2 1"), false, "predict --first=0",
+       "events.txt:3: field 't'"},
+      {"overflow", "events.txt", ReplaceLine(events, 3, "1.02 99999999999999999999 2 1"), false,
+       "predict --first=0", "events.txt:3: x = 99999999999999999999 is outside"},
+      {"binary", "events.txt", ReplaceLine(events, 3, std::string("\x01\xff\0\x1b[2J", 7)), false,
+       "predict --first=0", "events.txt:3:"},
+      {"megabyte_line", "events.txt", ReplaceLine(events, 3, "1.02 " + megabyte + " 2 1"), false,
+       "predict --first=0", "events.txt:3: x = 9999"},
+      {"truncated", "events.txt", events + "1.095 1", false, "predict --first=0",
+       "events.txt:11: expected 4 fields"},
+      {"outside_sensor", "events.txt", ReplaceLine(events, 3, "1.02 16 2 1"), false,
+       "predict --first=0", "events.txt:3: x = 16 is outside the sensor"},
+      {"polarity", "events.txt", ReplaceLine(events, 3, "1.02 2 2 2"), false, "predict --first=0",
+       "events.txt:3: polarity must be -1, 0 or 1"},
+      {"events_backwards", "events.txt", ReplaceLine(events, 3, "0.5 2 2 1"), false,
+       "predict --first=0", "events.txt:3: timestamps must not decrease"},
+      {"images_backwards", "images.txt", "1.0 images/a.png\n0.9 images/b.png\n", false,
+       "predict --first=0", "images.txt:2: frame timestamps must increase"},
+      {"images_malformed", "images.txt", "1.0 images/a.png\n1.1\n", false, "predict --first=0",
+       "images.txt:2: expected 't path'"},
+      {"exposures_malformed", "exposures.txt", "images/a.png 0.95 nan\n", false, "deblur --first=0",
+       "exposures.txt:1: field 't_end'"},
+      {"missing_events", "events.txt", "", true, "predict --first=0", "events.txt:"},
+      {"missing_image", "images/b.png", "", true, "interpolate --first=0 --last=1",
+       "images/b.png: image file does not exist"},
+      {"unreadable_image", "images/b.png", "not a png", false, "interpolate --first=0 --last=1",
+       "images/b.png: cannot decode"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path data = WriteTinyFolder(scratch / c.name);
+    if (c.remove) {
+      fs::remove(data / c.file);
+    } else {
+      testing::WriteFile((data / c.file).string(), c.content);
+    }
+    ExpectUserError(RunEvfs("reconstruct --data=" + data.string() + " --mode=" + c.mode +
+                            " --out=" + out.string()),
+                    c.expected, out);
+  }
+}
+
+TEST(EvfsCli, ImageOfAnotherSizeIsAUserError) {
+  const fs::path scratch = testing::ScratchDir("image_size");
+  const fs::path data = WriteTinyFolder(scratch / "data");
+  WriteGreyPng8((data / "images/b.png").string(),
+                testing::MakeRandomImage(3, kTinyWidth + 1, kTinyHeight, 8));
+  const fs::path out = scratch / "out";
+  ExpectUserError(RunEvfs("reconstruct --data=" + data.string() +
+                          " --mode=interpolate --first=0 --last=1 --out=" + out.string()),
+                  "images/b.png: image is 17x12, expected the sensor size 16x12", out);
+}
+
+TEST(EvfsCli, CorruptOrIncompleteHdf5IsAUserError) {
+  const fs::path scratch = testing::ScratchDir("bad_hdf5");
+  const fs::path good = scratch / "good.h5";
+  ConvertRecording(WriteTinyFolder(scratch / "data").string(), good.string());
+  const fs::path out = scratch / "out";
+  const auto reconstruct = [&](const fs::path& h5) {
+    return RunEvfs("reconstruct --data=" + h5.string() +
+                   " --mode=predict --first=0 --out=" + out.string());
+  };
+  ASSERT_EQ(reconstruct(good).exit_code, 0);
+  fs::remove_all(out);
+
+  const fs::path truncated = scratch / "truncated.h5";
+  fs::copy_file(good, truncated);
+  fs::resize_file(truncated, fs::file_size(good) / 2);
+  ExpectUserError(reconstruct(truncated), truncated.string() + ":", out);
+
+  const fs::path garbage = scratch / "garbage.h5";
+  testing::WriteFile(garbage.string(), std::string(4096, '\x01'));
+  ExpectUserError(reconstruct(garbage), garbage.string() + ": not an HDF5 file", out);
+
+  const fs::path no_frames = scratch / "no_frames.h5";
+  WriteHdf5(no_frames.string(), EventStream(), {}, {});
+  ExpectUserError(reconstruct(no_frames), no_frames.string() + " has 0 frames", out);
+}
+
+TEST(EvfsCli, UnwritableOutputIsAUserError) {
+  const fs::path scratch = testing::ScratchDir("unwritable");
+  const fs::path data = WriteTinyFolder(scratch / "data");
+  testing::WriteFile((scratch / "file").string(), "a file, not a folder");
+  const fs::path out = scratch / "file" / "out";
+  const CommandResult result = RunEvfs("reconstruct --data=" + data.string() +
+                                       " --mode=predict --first=0 --out=" + out.string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
+  EXPECT_NE(result.errors.find(out.string() + ": cannot create the output folder"),
+            std::string::npos)
+      << result.errors;
+  const CommandResult convert =
+      RunEvfs("convert --data=" + data.string() + " --out=" + (scratch / "file/x.h5").string());
+  EXPECT_EQ(convert.exit_code, 2) << convert.output;
+  EXPECT_NE(convert.errors.find("file/x.h5: cannot create the HDF5 file"), std::string::npos)
+      << convert.errors;
+}
+
+TEST(EvfsCli, ConvertAndSimulateLeaveNothingBehindOnBadInput) {
+  const fs::path scratch = testing::ScratchDir("convert_bad");
+  const fs::path data = WriteTinyFolder(scratch / "data");
+  testing::WriteFile((data / "events.txt").string(), ReplaceLine(TinyEventLines(), 9, "1.08 1"));
+  for (const char* out_name : {"out.h5", "out"}) {
+    SCOPED_TRACE(out_name);
+    const fs::path out = scratch / out_name;
+    ExpectUserError(RunEvfs("convert --data=" + data.string() + " --out=" + out.string()),
+                    "events.txt:9: expected 4 fields", out);
+  }
+  fs::remove(data / "images/a.png");
+  ExpectUserError(
+      RunEvfs("simulate --frames=" + data.string() + " --out=" + (scratch / "sim").string()),
+      "images/a.png: image file does not exist", scratch / "sim");
+}
+
+// CRLF, comments, blank lines, -1/1 polarity and last lines without a newline are valid.
+TEST(EvfsCli, OdditiesOfRealFilesAreAccepted) {
+  const fs::path scratch = testing::ScratchDir("oddities");
+  const fs::path data = WriteTinyFolder(scratch / "data");
+  std::string odd = "# t x y p\r\n\r\n";
+  std::istringstream lines(TinyEventLines());
+  for (std::string line; std::getline(lines, line);) {
+    if (line.back() == '0') line = line.substr(0, line.size() - 1) + "-1";
+    odd += line + "\r\n";
+  }
+  odd.resize(odd.size() - 2);  // no newline after the last event
+  testing::WriteFile((data / "events.txt").string(), odd);
+  testing::WriteFile((data / "images.txt").string(),
+                     "# t path\r\n1.0 images/a.png\r\n\n1.1 images/b.png");
+  const fs::path out = scratch / "out";
+  const CommandResult run = RunEvfs("reconstruct --data=" + data.string() +
+                                    " --mode=interpolate --first=0 --last=1 --out=" + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(ReadFile(out / "summary.json").find("\"events\": 10,"), std::string::npos);
+}
+
+// A window without events is answered with the initialisation (here a copy of the frame).
+TEST(EvfsCli, WindowWithoutEventsGivesTheInitialisation) {
+  const fs::path scratch = testing::ScratchDir("no_events");
+  const fs::path data = WriteTinyFolder(scratch / "data");
+  testing::WriteFile((data / "events.txt").string(), "# no events\n");
+  const fs::path out = scratch / "out";
+  const CommandResult run = RunEvfs("reconstruct --data=" + data.string() +
+                                    " --mode=predict --first=0 --out=" + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(ReadFile(out / "summary.json").find("\"solved\": false"), std::string::npos);
+  const Image first = ReadGreyImage((data / "images/a.png").string());
+  for (const auto& entry : fs::directory_iterator(out / "frames")) {
+    // An 8-bit frame written as 16 bits comes back exactly (k/255 = 257k/65535).
+    EXPECT_TRUE((ReadGreyImage(entry.path().string()) == first).all()) << entry.path();
   }
 }
 

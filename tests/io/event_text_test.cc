@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -119,7 +120,10 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(MalformedCase{"t_word", "abc 1 2 1", kMalformed, "'t'"},
                       MalformedCase{"t_suffix", "0.6s 1 2 1", kMalformed, "'t'"},
                       MalformedCase{"t_exponent", "6e-1 1 2 1", kMalformed, "'t'"},
-                      MalformedCase{"x_word", "0.6 a 2 1", kMalformed, "'x'"}),
+                      MalformedCase{"t_nan", "nan 1 2 1", kMalformed, "'t'"},
+                      MalformedCase{"t_inf", "inf 1 2 1", kMalformed, "'t'"},
+                      MalformedCase{"x_word", "0.6 a 2 1", kMalformed, "'x'"},
+                      MalformedCase{"x_nan", "0.6 nan 2 1", kMalformed, "'x'"}),
     CaseName);
 
 INSTANTIATE_TEST_SUITE_P(
@@ -159,6 +163,73 @@ TEST(EventTextReaderTest, ErrorOnTheLastLineWithoutNewlineNamesItsLine) {
   const std::string tail_path = EventsFile("tail_error", "0.5 1 2 1\n0.6 1 2 1\n0.7 1 2 5");
   testing::ExpectInputError([&] { ReadEventsText(tail_path, kWidth, kHeight); },
                             InputError::Kind::kOutOfRange, tail_path, 3);
+}
+
+TEST(EventTextReaderTest, TruncatedLastLineIsMalformed) {
+  // A file cut short while it was written: the last line lacks fields and its newline.
+  const std::string path = EventsFile("truncated", "0.5 1 2 1\n0.6 1 2 1\n0.7 1");
+  testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
+                            InputError::Kind::kMalformed, path, 3);
+  const InputError error = testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); });
+  EXPECT_NE(std::string(error.what()).find("found 2"), std::string::npos) << error.what();
+}
+
+TEST(EventTextReaderTest, MegabyteLinesGiveShortMessages) {
+  constexpr size_t kMegabyte = 1 << 20;
+  const struct {
+    const char* name;
+    std::string bad_line;
+    InputError::Kind kind;
+  } cases[] = {
+      {"t_digits", std::string(kMegabyte, '7') + " 1 2 1", InputError::Kind::kMalformed},
+      {"x_digits", "0.6 " + std::string(kMegabyte, '9') + " 2 1", InputError::Kind::kOutOfRange},
+      {"p_word", "0.6 1 2 " + std::string(kMegabyte, 'p'), InputError::Kind::kMalformed},
+      {"p_digits", "0.6 1 2 " + std::string(kMegabyte, '5'), InputError::Kind::kOutOfRange},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path =
+        EventsFile(std::string("megabyte_") + c.name, "0.5 1 2 1\n" + c.bad_line + "\n");
+    testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); }, c.kind, path, 2);
+    testing::ExpectShortPrintableMessage(
+        testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); }));
+  }
+}
+
+TEST(EventTextReaderTest, BinaryGarbageIsMalformedWithAPrintableMessage) {
+  // Every byte value but '\n' (NUL and control characters included), from a seeded generator,
+  // after a control character so that the line is neither a comment nor a number.
+  std::mt19937 random(17);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::string garbage = "\x01";
+  while (garbage.size() < 4096) {
+    const char c = static_cast<char>(byte(random));
+    if (c != '\n') garbage += c;
+  }
+  for (const std::string& bad_line :
+       {garbage, "0.6 1 2 " + garbage, std::string("0.6\x01 1 2 1")}) {
+    const std::string path = EventsFile("binary", "0.5 1 2 1\n" + bad_line + "\n0.7 1 2 1\n");
+    testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
+                              InputError::Kind::kMalformed, path, 2);
+    testing::ExpectShortPrintableMessage(
+        testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); }));
+  }
+}
+
+TEST(EventTextReaderTest, BytesInMemoryParseLikeTheFile) {
+  const std::string content = "# t x y p\r\n0.5 1 2 1\n0.6 3 4 -1\n0.7 5 6 0";
+  const std::string path = EventsFile("from_memory", content);
+  const EventTextReader from_memory(
+      MappedFile::FromMemory("memory/events.txt", content.data(), content.size()), kWidth, kHeight);
+  EXPECT_EQ(from_memory.path(), "memory/events.txt");
+  EXPECT_EQ(from_memory.ReadAll(), ReadEventsText(path, kWidth, kHeight));
+  EXPECT_EQ(from_memory.Read(600000000, 700000000).size(), 1u);
+  const std::string bad = "0.5 1 2 1\n0.6 1 2\n";
+  testing::ExpectInputError(
+      [&] {
+        EventTextReader(MappedFile::FromMemory("memory/bad.txt", bad.data(), bad.size())).ReadAll();
+      },
+      InputError::Kind::kMalformed, "memory/bad.txt", 2);
 }
 
 TEST(EventTextReaderTest, ErrorDeepInALargeFileNamesItsLine) {

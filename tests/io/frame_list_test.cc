@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -61,13 +62,58 @@ TEST(ReadFrameListTest, MalformedLinesNameFileAndLine) {
   ExpectBadLineErrors("images.txt", first, InputError::Kind::kMalformed,
                       {{"no_path", "2.5"},
                        {"bad_time", "2.5x images/b.png"},
+                       {"nan_time", "nan images/b.png"},
                        {"ten_digits", "2.5000000001 images/b.png"},
+                       {"overflow", "99999999999 images/b.png"},
+                       {"control_character", "2.5 images/\x1b[2Jb.png"},
                        {"same_path", "2.5 images/a.png"}},
                       read);
   ExpectBadLineErrors("images.txt", first, InputError::Kind::kNotMonotonic,
                       {{"same_time", "1.5 images/b.png"}, {"backwards", "1.4 images/b.png"}}, read);
   testing::ExpectInputError([&] { ReadFrameList("/no/such/images.txt"); },
                             InputError::Kind::kMissingFile, "/no/such/images.txt", 0);
+}
+
+TEST(ReadFrameListTest, TruncatedLastLineIsMalformed) {
+  // A file cut short while it was written: the last line lacks its path and its newline.
+  const std::string path =
+      TextFile("frames_truncated", "images.txt", "1.5 images/a.png\n2.5 images/b.png\n3.");
+  testing::ExpectInputError([&] { ReadFrameList(path); }, InputError::Kind::kMalformed, path, 3);
+}
+
+TEST(ReadFrameListTest, MegabyteLinesAndBinaryGarbageGiveShortMessages) {
+  constexpr size_t kMegabyte = 1 << 20;
+  std::string garbage;
+  for (int i = 0; i < 4096; ++i) garbage += static_cast<char>(i % 256 == '\n' ? 0 : i % 256);
+  const struct {
+    const char* name;
+    std::string bad_line;
+  } cases[] = {
+      {"long_time", std::string(kMegabyte, '7') + "x images/b.png"},
+      {"long_path", "2.5 images/" + std::string(kMegabyte, 'b') + ".png"},
+      {"one_word", std::string(kMegabyte, 'w')},
+      {"garbage", garbage},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = TextFile(std::string("frames_") + c.name, "images.txt",
+                                      "1.5 images/a.png\n" + c.bad_line + "\n");
+    testing::ExpectInputError([&] { ReadFrameList(path); }, InputError::Kind::kMalformed, path, 2);
+    testing::ExpectShortPrintableMessage(testing::CatchInputError([&] { ReadFrameList(path); }));
+  }
+}
+
+TEST(ReadFrameListTest, StreamsInMemoryReadLikeTheFile) {
+  const std::string images = "# t path\r\n1.5 images/a.png\n2.5 images/b.png";
+  std::istringstream images_stream(images);
+  std::vector<FrameInfo> frames = ReadFrameList(images_stream, "memory/images.txt");
+  EXPECT_EQ(frames, ReadFrameList(TextFile("frames_stream", "images.txt", images)));
+  std::istringstream exposures("images/b.png 2.4 2.6\n");
+  ReadExposures(exposures, "memory/exposures.txt", &frames);
+  EXPECT_TRUE(frames[1].has_exposure);
+  std::istringstream bad("1.5 images/a.png\n1.5 images/b.png\n");
+  testing::ExpectInputError([&] { ReadFrameList(bad, "memory/images.txt"); },
+                            InputError::Kind::kNotMonotonic, "memory/images.txt", 2);
 }
 
 TEST(ReadExposuresTest, MatchesByPath) {
@@ -101,6 +147,7 @@ TEST(ReadExposuresTest, RejectsUnknownPathsAndEmptyExposures) {
                       {{"unknown_path", "images/other.png 1.0 2.0"},
                        {"two_fields", "images/b.png 2.0"},
                        {"bad_number", "images/b.png 1.0 two"},
+                       {"nan", "images/b.png nan 2.0"},
                        {"twice", "images/a.png 1.0 2.0"}},
                       read);
   ExpectBadLineErrors(

@@ -51,6 +51,15 @@ std::pair<H5T_class_t, size_t> DatasetType(const std::string& path, const std::s
   return result;
 }
 
+// Writes the scalar attribute `name` of `type` onto `object`.
+void WriteScalarAttribute(hid_t object, const char* name, hid_t type, const void* value) {
+  const hid_t scalar = H5Screate(H5S_SCALAR);
+  const hid_t attribute = H5Acreate2(object, name, type, scalar, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(attribute, type, value);
+  H5Aclose(attribute);
+  H5Sclose(scalar);
+}
+
 // Writes /events/{ts,xs,ys,ps} with the given file types, the way other tools do.
 template <typename T, typename P>
 void WriteRawEvents(const std::string& path, const std::vector<T>& ts, hid_t ts_type,
@@ -67,12 +76,7 @@ void WriteRawEvents(const std::string& path, const std::vector<T>& ts, hid_t ts_
     if (ts_unit != nullptr && std::string(name) == "ts") {
       const hid_t string_type = H5Tcopy(H5T_C_S1);
       H5Tset_size(string_type, H5T_VARIABLE);
-      const hid_t scalar = H5Screate(H5S_SCALAR);
-      const hid_t attribute =
-          H5Acreate2(dataset, "ts_unit", string_type, scalar, H5P_DEFAULT, H5P_DEFAULT);
-      H5Awrite(attribute, string_type, &ts_unit);
-      H5Aclose(attribute);
-      H5Sclose(scalar);
+      WriteScalarAttribute(dataset, "ts_unit", string_type, &ts_unit);
       H5Tclose(string_type);
     }
     H5Dclose(dataset);
@@ -238,6 +242,101 @@ TEST(Hdf5IoTest, CorruptOrIncompleteFilesAreInputErrors) {
 
   testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/nope.h5"); },
                             InputError::Kind::kMissingFile, dir + "/nope.h5", 0);
+}
+
+// A dataset created but never (or only partly) written reads as fill values; the reader must
+// call that an incomplete file, not zeros (a 7 KB file could otherwise claim a 65536x65536 frame).
+TEST(Hdf5IoTest, DeclaredButUnwrittenDataIsAnInputError) {
+  const std::string dir = testing::ScratchDir("h5_unwritten");
+  const Recording recording = MakeRecording(6, 100);
+  // Replaces dataset `name` of a fresh copy of the recording by one of `dims` and `type`, chunked
+  // by `chunk`, of which only the first chunk is written when `write_first_chunk`.
+  const auto recreated = [&](const std::string& file_name, const std::string& name,
+                             std::vector<hsize_t> dims, std::vector<hsize_t> chunk, hid_t type,
+                             bool write_first_chunk) {
+    const std::string path = dir + "/" + file_name;
+    WriteHdf5(path, recording.events, recording.frames, recording.images);
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    EXPECT_GE(H5Ldelete(file, name.c_str(), H5P_DEFAULT), 0);
+    const hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+    const hid_t properties = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(properties, static_cast<int>(chunk.size()), chunk.data());
+    const hid_t dataset =
+        H5Dcreate2(file, name.c_str(), type, space, H5P_DEFAULT, properties, H5P_DEFAULT);
+    if (write_first_chunk) {
+      const std::vector<hsize_t> origin(dims.size(), 0);
+      H5Sselect_hyperslab(space, H5S_SELECT_SET, origin.data(), nullptr, chunk.data(), nullptr);
+      const hid_t memory = H5Screate_simple(static_cast<int>(chunk.size()), chunk.data(), nullptr);
+      const std::vector<uint8_t> zeros(1 << 16, 0);
+      H5Dwrite(dataset, H5T_NATIVE_UINT8, memory, space, H5P_DEFAULT, zeros.data());
+      H5Sclose(memory);
+    }
+    const double timestamp = 3.0;
+    WriteScalarAttribute(dataset, "timestamp", H5T_NATIVE_DOUBLE, &timestamp);
+    H5Dclose(dataset);
+    H5Pclose(properties);
+    H5Sclose(space);
+    H5Fclose(file);
+    return testing::CatchInputError([&] { Hdf5DataSource source(path); });
+  };
+  const struct {
+    const char* file_name;
+    InputError error;
+    const char* message_part;
+  } cases[] = {
+      {"events.h5", recreated("events.h5", "events/ps", {100}, {50}, H5T_STD_I8LE, false),
+       "events/ps declares 100 1-byte values but the file stores 0 bytes"},
+      {"image.h5",
+       recreated("image.h5", "images/image000000001", {65536, 65536}, {256, 256}, H5T_STD_U8LE,
+                 false),
+       "images/image000000001 declares 65536x65536 1-byte values but the file stores 0 bytes"},
+      {"partial.h5",
+       recreated("partial.h5", "images/image000000001", {kHeight, kWidth}, {kHeight / 2, kWidth},
+                 H5T_STD_U8LE, true),
+       "images/image000000001 declares 48x64 1-byte values but the file stores 1536 bytes"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.file_name);
+    EXPECT_EQ(c.error.kind(), InputError::Kind::kMalformed);
+    EXPECT_NE(std::string(c.error.what()).find(c.message_part), std::string::npos)
+        << c.error.what();
+  }
+}
+
+// Image names and paths end up in messages and file names, so they must be printable text.
+TEST(Hdf5IoTest, UnprintableImageNamesAndPathsAreMalformed) {
+  const std::string dir = testing::ScratchDir("h5_names");
+  Recording recording = MakeRecording(5, 10);
+  recording.frames[1].path = "images/\x1b[2Jb.png";
+  WriteHdf5(dir + "/path.h5", recording.events, recording.frames, recording.images);
+  const InputError path_error =
+      testing::CatchInputError([&] { Hdf5DataSource source(dir + "/path.h5"); });
+  EXPECT_EQ(path_error.kind(), InputError::Kind::kMalformed);
+  EXPECT_NE(std::string(path_error.what()).find("images/\\x1b[2Jb.png' holds a control"),
+            std::string::npos)
+      << path_error.what();
+
+  const Recording good = MakeRecording(5, 10);
+  const auto renamed = [&](const std::string& name, const std::string& new_name) {
+    const std::string path = dir + "/" + name + ".h5";
+    WriteHdf5(path, good.events, good.frames, good.images);
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    EXPECT_GE(H5Lmove(file, "images/image000000001", file, ("images/" + new_name).c_str(),
+                      H5P_DEFAULT, H5P_DEFAULT),
+              0);
+    H5Fclose(file);
+    return testing::CatchInputError([&] { Hdf5DataSource source(path); });
+  };
+  const InputError control = renamed("control", "image\x01");
+  EXPECT_EQ(control.kind(), InputError::Kind::kMalformed);
+  EXPECT_NE(std::string(control.what()).find("images/image\\x01: expected a printable"),
+            std::string::npos)
+      << control.what();
+  const InputError long_name = renamed("long_name", std::string(1000, 'n'));
+  EXPECT_EQ(long_name.kind(), InputError::Kind::kMalformed);
+  EXPECT_NE(std::string(long_name.what()).find("(1000 bytes): expected a printable"),
+            std::string::npos)
+      << long_name.what();
 }
 
 TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {

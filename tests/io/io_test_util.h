@@ -114,6 +114,19 @@ void ExpectInputError(Body&& body, InputError::Kind kind, const std::string& fil
   }
 }
 
+/// An error message must be one short printable line however long or binary the input was: it
+/// quotes input cut short (io/message_excerpt.h), so it holds the file name and at most this
+/// many other bytes.
+constexpr size_t kMaxMessageBytesBesidesPath = 200;
+
+inline void ExpectShortPrintableMessage(const InputError& error) {
+  const std::string message = error.what();
+  EXPECT_LT(message.size(), error.file().size() + kMaxMessageBytesBesidesPath) << message;
+  for (const char c : message) {
+    ASSERT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << message;
+  }
+}
+
 }  // namespace testing
 }  // namespace evfs
 

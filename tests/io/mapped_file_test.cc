@@ -37,6 +37,17 @@ TEST(MappedFileTest, MovingTransfersTheMapping) {
   EXPECT_EQ(std::string(third.data(), third.size()), "abc");
 }
 
+TEST(MappedFileTest, FromMemoryWrapsTheBytesWithoutCopying) {
+  const std::string bytes = "0.5 1 2 1\n";
+  MappedFile file = MappedFile::FromMemory("memory/events.txt", bytes.data(), bytes.size());
+  EXPECT_EQ(file.path(), "memory/events.txt");
+  EXPECT_EQ(file.data(), bytes.data());
+  EXPECT_EQ(file.size(), bytes.size());
+  // Moving and destroying must not try to unmap memory that was never mapped.
+  MappedFile moved(std::move(file));
+  EXPECT_EQ(moved.data(), bytes.data());
+}
+
 TEST(MappedFileTest, MissingFileOrFolderIsAnInputError) {
   const std::string dir = testing::ScratchDir("mapped_missing");
   testing::ExpectInputError([&] { MappedFile file(dir + "/nope.txt"); },

@@ -1,0 +1,139 @@
+// Writes the seed corpora of the fuzz targets from the shared DAVIS snippets, into the build
+// folder (never into the repository):
+//   OUT/event_text/  the first 4 KB of every events.txt (cut at a line end), and 20 KB of one
+//                    so that windowed reads take the binary search
+//   OUT/frame_list/  every images.txt and exposures.txt, and each images.txt joined by a NUL
+//                    byte to the exposures.txt beside it (see frame_list_fuzzer.cc)
+//   OUT/hdf5_io/     tiny recordings cut from the snippets and converted to HDF5 by
+//                    ConvertRecording, the code behind `evfs convert`
+//
+//   fuzz_seed_corpus DATA_DIR OUT
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "io/data_source.h"
+#include "io/event_text.h"
+#include "io/frame_list.h"
+#include "io/image_io.h"
+#include "io/text_folder.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr size_t kEventSeedBytes = 4 * 1024;
+// Every images.txt and exposures.txt of the shared data is smaller.
+constexpr size_t kListSeedBytes = 64 * 1024;
+// More than the 16 KB below which the event reader scans linearly instead of searching.
+constexpr size_t kLargeEventSeedBytes = 20 * 1024;
+// Tiny recordings keep HDF5 seeds at a few KB: the first events inside a corner of the sensor.
+constexpr int kCropWidth = 16;
+constexpr int kCropHeight = 12;
+constexpr size_t kCropEvents = 40;
+// Beyond ~50 days float64 seconds lose nanoseconds, so WriteHdf5 stores int64 ns with ts_unit.
+constexpr int64_t kFarFutureNs = 100LL * 24 * 3600 * 1000000000LL;
+
+std::string ReadPrefix(const fs::path& path, size_t bytes) {
+  std::ifstream stream(path, std::ios::binary);
+  std::string text(bytes, '\0');
+  stream.read(&text[0], static_cast<std::streamsize>(bytes));
+  text.resize(static_cast<size_t>(stream.gcount()));
+  return text.substr(0, text.rfind('\n') + 1);  // whole lines only
+}
+
+void WriteText(const fs::path& path, const std::string& text) {
+  std::ofstream stream(path, std::ios::binary);
+  stream << text;
+  if (!stream) throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "cannot write");
+}
+
+// The first kCropEvents events inside the crop (time-shifted by `shift_ns`), and the first two
+// frames cropped to it when `with_frames`.
+void WriteTinyRecording(const DataSource& source, bool with_frames, int64_t shift_ns,
+                        const fs::path& h5_path, const fs::path& scratch) {
+  EventStream events(kCropWidth, kCropHeight);
+  const EventStream all = source.ReadAllEvents();
+  for (size_t i = 0; i < all.size() && events.size() < kCropEvents; ++i) {
+    if (all.x(i) < kCropWidth && all.y(i) < kCropHeight) {
+      events.push_back(all.t_ns(i) + shift_ns, all.x(i), all.y(i), all.polarity(i));
+    }
+  }
+  std::vector<FrameInfo> frames;
+  std::vector<Image> images;
+  for (int i = 0; with_frames && i < std::min<int>(2, source.frames().size()); ++i) {
+    FrameInfo frame = source.frames()[i];
+    frame.t_ns += shift_ns;
+    frame.exposure_begin_ns += shift_ns;
+    frame.exposure_end_ns += shift_ns;
+    frames.push_back(frame);
+    images.push_back(source.ReadImage(i).topLeftCorner(kCropHeight, kCropWidth));
+  }
+  fs::remove_all(scratch);
+  WriteDataFolder(scratch.string(), events, frames, images);
+  ConvertRecording(scratch.string(), h5_path.string());
+  fs::remove_all(scratch);
+}
+
+int Run(const fs::path& data_dir, const fs::path& out) {
+  for (const char* target : {"event_text", "frame_list", "hdf5_io"}) {
+    fs::create_directories(out / target);
+  }
+  std::vector<fs::path> snippets;
+  for (const fs::directory_entry& entry : fs::directory_iterator(data_dir)) {
+    if (entry.is_directory()) snippets.push_back(entry.path());
+  }
+  std::sort(snippets.begin(), snippets.end());
+  bool wrote_large = false;
+  for (const fs::path& snippet : snippets) {
+    const std::string name = snippet.filename().string();
+    for (const char* list : {"images.txt", "exposures.txt"}) {
+      if (fs::is_regular_file(snippet / list)) {
+        WriteText(out / "frame_list" / (name + "_" + list),
+                  ReadPrefix(snippet / list, kListSeedBytes));
+      }
+    }
+    if (fs::is_regular_file(snippet / "exposures.txt")) {
+      WriteText(out / "frame_list" / (name + "_both"),
+                ReadPrefix(snippet / "images.txt", kListSeedBytes) + '\0' +
+                    ReadPrefix(snippet / "exposures.txt", kListSeedBytes));
+    }
+    if (!fs::is_regular_file(snippet / "events.txt")) continue;
+    WriteText(out / "event_text" / name, ReadPrefix(snippet / "events.txt", kEventSeedBytes));
+    if (!wrote_large) {
+      WriteText(out / "event_text" / (name + "_large"),
+                ReadPrefix(snippet / "events.txt", kLargeEventSeedBytes));
+      wrote_large = true;
+    }
+    const auto source = DataSource::Open(snippet.string());
+    const fs::path scratch = out / "tiny_recording";
+    WriteTinyRecording(*source, true, 0, out / "hdf5_io" / (name + ".h5"), scratch);
+    WriteTinyRecording(*source, false, 0, out / "hdf5_io" / (name + "_events.h5"), scratch);
+    WriteTinyRecording(*source, false, kFarFutureNs, out / "hdf5_io" / (name + "_ns.h5"), scratch);
+  }
+  std::printf("seed corpora from %zu snippets of %s in %s\n", snippets.size(), data_dir.c_str(),
+              out.c_str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace evfs
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: fuzz_seed_corpus DATA_DIR OUT\n");
+    return 2;
+  }
+  try {
+    return evfs::Run(argv[1], argv[2]);
+  } catch (const evfs::Error& error) {
+    std::fprintf(stderr, "fuzz_seed_corpus: %s\n", error.what());
+    return 2;
+  }
+}
