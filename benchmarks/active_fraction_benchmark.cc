@@ -95,11 +95,15 @@ int Run() {
     const Image& truth = video.frame(middle);
     const Video blend = InitializeLatentVideo(scene);
     const int index = result.video.NearestFrame(video.timestamp_ns(middle));
-    const double gain =
-        Psnr(result.video.frame(index), truth) - Psnr(blend.frame(index), truth);
+    // Without events the answer is the blend itself: no gain to report.
+    char gain[32] = "-";
+    if (result.summary.solved) {
+      std::snprintf(gain, sizeof(gain), "%+.2f dB",
+                    Psnr(result.video.frame(index), truth) - Psnr(blend.frame(index), truth));
+    }
     const double per_unknown =
         unknowns > 0 ? 1e6 * (Median(build_s) + Median(solve_s)) / unknowns : 0.0;
-    std::printf("| %.0f %% | %lld | %lld | %lld | %d | %.3f | %.3f | %.1f | %+.2f dB |\n",
+    std::printf("| %.0f %% | %lld | %lld | %lld | %d | %.3f | %.3f | %.1f | %s |\n",
                 100.0 * fraction, static_cast<long long>(events.size()),
                 static_cast<long long>(result.summary.problem.active_pixels),
                 static_cast<long long>(unknowns), scene.num_latent_frames(), Median(build_s),
