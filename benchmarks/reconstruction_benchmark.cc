@@ -10,19 +10,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
+#include "benchmarks/benchmark_cases.h"
 #include "core/error.h"
 #include "core/metrics.h"
-#include "events/simulator.h"
 #include "examples/reconstruct_job.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
@@ -58,17 +55,8 @@ struct Row {
   double wall_s = 0.0;
 };
 
-std::vector<std::string> Split(const std::string& text) {
-  std::vector<std::string> parts;
-  std::stringstream stream(text);
-  for (std::string part; std::getline(stream, part, ',');) {
-    if (!part.empty()) parts.push_back(part);
-  }
-  return parts;
-}
-
 bool Wants(const std::string& name) {
-  for (const std::string& c : Split(FLAGS_cases)) {
+  for (const std::string& c : SplitCommaList(FLAGS_cases)) {
     if (c == name) return true;
   }
   return false;
@@ -146,83 +134,49 @@ std::vector<Row> RunCupsDeblur(int frame) {
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   const double wall_s = SecondsSince(start);
-  const Video& latent = result.run.video;
-  const Image blurred = result.baseline.frame(0);
-  Image mean = Image::Zero(latent.height(), latent.width());
-  double sharpness = 0.0;
-  for (int t = 0; t < latent.num_frames(); ++t) {
-    mean += latent.frame(t);
-    sharpness += LaplacianVariance(latent.frame(t));
-  }
-  mean /= latent.num_frames();
-  sharpness /= latent.num_frames();
+  const int latent_frames = result.run.video.num_frames();
+  const DeblurWithoutTruthScore score =
+      ScoreDeblurWithoutTruth(result.run.video, result.baseline.frame(0));
   const std::string name = "eslnet_cups_blur #" + std::to_string(frame);
   return {
-      Row{name, "deblur", "mean of latent frames vs input, PSNR dB", 0.0, Psnr(mean, blurred), "-",
-          latent.num_frames(), wall_s},
-      Row{name, "deblur", "variance of Laplacian ×1e3 (mean of latent)", 1e3 * LaplacianVariance(blurred),
-          1e3 * sharpness, "input", latent.num_frames(), wall_s},
+      Row{name, "deblur", "mean of latent frames vs input, PSNR dB", 0.0,
+          score.mean_vs_input_psnr, "-", latent_frames, wall_s},
+      Row{name, "deblur", "variance of Laplacian ×1e3 (mean of latent)",
+          1e3 * score.input_sharpness, 1e3 * score.latent_sharpness, "input", latent_frames,
+          wall_s},
   };
 }
 
-struct Clip {
-  Video frames;
-  EventStream events;
-};
-
-Clip LoadClip(const std::string& name, int num_frames) {
-  const fs::path folder = fs::path(FLAGS_data) / name;
-  const std::vector<FrameInfo> list = ReadFrameList((folder / "images.txt").string());
-  Clip clip;
-  for (int i = 0; i < num_frames && i < static_cast<int>(list.size()); ++i) {
-    clip.frames.AppendFrame(ReadGreyImage((folder / list[i].path).string()), list[i].t_ns);
-  }
-  clip.events = SimulateEvents(clip.frames, SimulatorOptions());
-  return clip;
-}
-
-TimedFrame Sharp(const Video& frames, int t) {
-  return TimedFrame{frames.frame(t), frames.timestamp_ns(t), frames.timestamp_ns(t),
-                    "frame " + std::to_string(t)};
-}
-
-Row RunClipInterpolation(const std::string& name, const Clip& clip) {
+Row RunClipInterpolation(const std::string& name, const SimulatedClip& clip) {
   const auto start = Clock::now();
-  const Scene scene =
-      MakeInterpolationScene(Sharp(clip.frames, 0), Sharp(clip.frames, 4), clip.events, Binning());
+  const Scene scene = MakeClipInterpolationScene(clip, Binning());
   std::string initial_method;
   const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
                                            BaselineOptions(), &initial_method);
   const Reconstruction result = Reconstruct(scene, Options(), &initial);
-  const int index = result.video.NearestFrame(clip.frames.timestamp_ns(2));
-  const Image& truth = clip.frames.frame(2);
+  const int index = result.video.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame));
+  const Image& truth = clip.frames.frame(kClipTruthFrame);
   return Row{name, "interpolate", "PSNR dB (frame 2 from 0, 4)",
              Psnr(InitializeLatentVideo(scene).frame(index), truth),
              Psnr(result.video.frame(index), truth), "blend", result.video.num_frames(),
              SecondsSince(start)};
 }
 
-Row RunClipDeblur(const std::string& name, const Clip& clip) {
-  constexpr int kBlurFrames = 8;
+Row RunClipDeblur(const std::string& name, const SimulatedClip& clip) {
   const auto start = Clock::now();
-  TimedFrame blurred{Image::Zero(clip.frames.height(), clip.frames.width()),
-                     clip.frames.timestamp_ns(0), clip.frames.timestamp_ns(kBlurFrames - 1),
-                     "mean of frames 0-7"};
-  for (int t = 0; t < kBlurFrames; ++t) blurred.image += clip.frames.frame(t);
-  blurred.image /= kBlurFrames;
-  const Scene scene = MakeDeblurScene(blurred, clip.events, Binning());
+  const Image blurred = ClipBlurredFrame(clip).image;
+  const Scene scene = MakeClipDeblurScene(clip, Binning());
   std::string initial_method;
   const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
                                            BaselineOptions(), &initial_method);
   const Reconstruction result = Reconstruct(scene, Options(), &initial);
-  double blurred_psnr = 0.0, evfs_psnr = 0.0;
-  for (int t = 0; t < kBlurFrames; ++t) {
-    const int index = result.video.NearestFrame(clip.frames.timestamp_ns(t));
-    blurred_psnr += Psnr(blurred.image, clip.frames.frame(t)) / kBlurFrames;
-    evfs_psnr += Psnr(result.video.frame(index), clip.frames.frame(t)) / kBlurFrames;
+  double blurred_psnr = 0.0;
+  for (int t = 0; t < kClipFrames; ++t) {
+    blurred_psnr += Psnr(blurred, clip.frames.frame(t)) / kClipFrames;
   }
-  return Row{name, "deblur", "PSNR dB (mean over frames 0-7)", blurred_psnr, evfs_psnr,
-             "blurred", result.video.num_frames(), SecondsSince(start)};
+  return Row{name, "deblur", "PSNR dB (mean over frames 0-7)", blurred_psnr,
+             ScoreClipDeblur(result.video, clip, Psnr), "blurred", result.video.num_frames(),
+             SecondsSince(start)};
 }
 
 int Main() {
@@ -243,8 +197,8 @@ int Main() {
     for (const Row& row : RunCupsDeblur(1)) add(row);
   }
   if (Wants("clips")) {
-    for (const std::string& name : Split(FLAGS_clips)) {
-      const Clip clip = LoadClip(name, 8);
+    for (const std::string& name : SplitCommaList(FLAGS_clips)) {
+      const SimulatedClip clip = LoadSimulatedClip(FLAGS_data, name);
       add(RunClipInterpolation(name, clip));
       add(RunClipDeblur(name, clip));
     }

@@ -9,10 +9,21 @@ cd "$(dirname "$0")/.."
 echo "== event file parsing (io_benchmark)"
 "$build/benchmarks/io_benchmark" --benchmark_counters_tabular=true
 
+echo
+echo "== cost functors, autodiff against hand-written derivatives; the fused evaluation"
+"$build/benchmarks/cost_function_benchmark" --benchmark_counters_tabular=true
+
+echo
+echo "== time against the active fraction of a synthetic scene"
+"$build/benchmarks/active_fraction_benchmark"
+
 if [ -d "$data" ]; then
   echo
   echo "== reconstructions on the shared data (default options; the simulated clips take long)"
   "$build/benchmarks/reconstruction_benchmark" --data="$data" --csv="$build/reconstruction.csv"
+  echo
+  echo "== every method on every case, one process per cell (method_benchmark)"
+  "$build/benchmarks/method_benchmark" --data="$data" --out="$build/bench"
 else
   echo "no shared data folder at $data: skipping the real-data runs"
 fi
