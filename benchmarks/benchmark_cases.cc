@@ -15,8 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 TimedFrame SharpClipFrame(const SimulatedClip& clip, int t) {
-  return TimedFrame{clip.frames.frame(t), clip.frames.timestamp_ns(t),
-                    clip.frames.timestamp_ns(t), "frame " + std::to_string(t)};
+  return TimedFrame{clip.frames.frame(t), clip.frames.timestamp_ns(t), clip.frames.timestamp_ns(t),
+                    "frame " + std::to_string(t)};
 }
 
 }  // namespace

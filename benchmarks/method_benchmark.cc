@@ -13,8 +13,12 @@
 // ceres_lm (default) needs to first reach Adam's final PSNR over Adam's whole time.
 //
 //   method_benchmark --data=../shared/data --out=build/bench [--quick] [--cases=a,b]
-//                    [--methods=ceres_lm,adam,...] [--clips=nfs_basketball_7,...]
+//                    [--methods=ceres_lm,adam,...] [--configs=default,per_voxel,...]
+//                    [--clips=nfs_basketball_7,...] [--cell_timeout_s=600]
+#include <gflags/gflags.h>
+#include <glog/logging.h>
 #include <sched.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -24,22 +28,21 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gflags/gflags.h>
-#include <glog/logging.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "baselines/baseline.h"
 #include "benchmarks/benchmark_cases.h"
 #include "core/error.h"
 #include "core/metrics.h"
+#include "core/time.h"
 #include "examples/method.h"
 #include "examples/reconstruct_job.h"
 #include "solver/problem_builder.h"
@@ -54,14 +57,21 @@ DEFINE_string(cases,
 DEFINE_string(methods, "",
               "Comma-separated methods (ceres_lm, ceres_lbfgs, adam, adam_smooth, blend, copy, "
               "integrate, cf, edi); empty: all.");
-// One adobe240 clip by default (kClipsDefaultNote says why).
-DEFINE_string(clips, "nfs_basketball_7,adobe240_GOPR9637b",
+// No adobe240 clip by default (kClipsDefaultNote says why).
+DEFINE_string(clips, "nfs_basketball_7",
               "Ground-truth clips for clip_interpolate and clip_deblur (nfs_basketball_7, "
               "adobe240_GOPR9637b, adobe240_GOPR9642, adobe240_IMG_0004b, adobe240_IMG_0036).");
 DEFINE_bool(quick, false,
             "Only slider_predict and shapes_interpolate, every method but ceres_lbfgs (unless "
-            "--methods names it) in its default configuration: no Ceres variants, no clips.");
+            "--methods names it) in its default configuration: no Ceres variants, no edi oracle.");
+DEFINE_string(configs, "default,sparse_cholesky,eta_0.01,per_voxel",
+              "Comma-separated ceres_lm configurations: default (CGNR + Jacobi, eta 0.1, merged "
+              "quiet steps), sparse_cholesky, eta_0.01, per_voxel.");
 DEFINE_int32(cell_timeout_s, 600, "A cell still running after this many seconds is stopped.");
+// A third of this 24 GB machine, which other work shares: a runaway cell (sparse Cholesky or the
+// per-voxel layout on a large scene) fails alone instead of starving the machine.
+DEFINE_int32(cell_memory_mb, 8192,
+             "Address-space limit of each cell's process, MB (RLIMIT_AS); 0: none.");
 DEFINE_string(cell, "", "Internal: run one cell 'case,method,config' and write --cell_result.");
 DEFINE_string(cell_result, "", "Internal: where --cell writes its result.");
 
@@ -71,14 +81,12 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Why --clips holds one of the four adobe240 clips by default.
+// Why --clips leaves the adobe240 clips out by default.
 constexpr char kClipsDefaultNote[] =
-    "the default has one of the four 500x500 adobe240 clips: each adds about five minutes on 2 "
-    "cores";
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+    "the four 500x500 adobe240 clips are left out by default: with the 12 M voxel budget one "
+    "adobe clip's interpolation took 45 s in ceres_lm and 110 s in adam on 2 cores, and the two "
+    "cases of one clip across the whole matrix would add well over half an hour; name them in "
+    "--clips to run them";
 
 // ---------------------------------------------------------------------------------------------
 // Cases and configurations.
@@ -343,7 +351,8 @@ CellResult RunClipCell(const Case& c, const MethodOptions& options, const std::s
     cell.psnr = ScoreClipDeblur(latent, clip, Psnr);
     cell.ssim = ScoreClipDeblur(latent, clip, Ssim);
   } else {
-    const Image estimate = latent.frame(latent.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame)));
+    const Image estimate =
+        latent.frame(latent.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame)));
     cell.psnr = Psnr(estimate, clip.frames.frame(kClipTruthFrame));
     cell.ssim = Ssim(estimate, clip.frames.frame(kClipTruthFrame));
   }
@@ -351,15 +360,20 @@ CellResult RunClipCell(const Case& c, const MethodOptions& options, const std::s
 }
 
 // The result file: one "key value" line per field, then "checkpoint it time_s cost psnr ssim"
-// lines.
+// lines. Numbers are read back with strtod, which also reads "inf" (the PSNR of a perfect copy).
+std::string OneLine(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return text;
+}
+
 void WriteCellResult(const CellResult& cell, const std::string& path) {
   std::ofstream out(path);
   out.precision(17);
-  out << "status " << cell.status << "\nbuild_s " << cell.build_s << "\nsolve_s " << cell.solve_s
-      << "\niterations " << cell.iterations << "\ninitial_cost " << cell.initial_cost
-      << "\nfinal_cost " << cell.final_cost << "\npsnr " << cell.psnr << "\nssim " << cell.ssim
-      << "\nsharpness_ratio " << cell.sharpness_ratio << "\nlatent_frames " << cell.latent_frames
-      << "\nnote " << cell.note << "\n";
+  out << "status " << OneLine(cell.status) << "\nbuild_s " << cell.build_s << "\nsolve_s "
+      << cell.solve_s << "\niterations " << cell.iterations << "\ninitial_cost "
+      << cell.initial_cost << "\nfinal_cost " << cell.final_cost << "\npsnr " << cell.psnr
+      << "\nssim " << cell.ssim << "\nsharpness_ratio " << cell.sharpness_ratio
+      << "\nlatent_frames " << cell.latent_frames << "\nnote " << OneLine(cell.note) << "\n";
   for (const Checkpoint& checkpoint : cell.checkpoints) {
     out << "checkpoint " << checkpoint.iteration << " " << checkpoint.time_s << " "
         << checkpoint.cost << " " << checkpoint.psnr << " " << checkpoint.ssim << "\n";
@@ -373,22 +387,29 @@ bool ReadCellResult(const std::string& path, CellResult* cell) {
     const size_t space = line.find(' ');
     const std::string key = line.substr(0, space);
     const std::string value = space == std::string::npos ? "" : line.substr(space + 1);
+    std::vector<double> numbers;
     std::istringstream fields(value);
+    for (std::string field; fields >> field;)
+      numbers.push_back(std::strtod(field.c_str(), nullptr));
+    numbers.resize(5, 0.0);  // the most a line holds: a checkpoint's five numbers
     if (key == "status") cell->status = value;
     if (key == "note") cell->note = value;
-    if (key == "build_s") fields >> cell->build_s;
-    if (key == "solve_s") fields >> cell->solve_s;
-    if (key == "iterations") fields >> cell->iterations;
-    if (key == "initial_cost") fields >> cell->initial_cost;
-    if (key == "final_cost") fields >> cell->final_cost;
-    if (key == "psnr") fields >> cell->psnr;
-    if (key == "ssim") fields >> cell->ssim;
-    if (key == "sharpness_ratio") fields >> cell->sharpness_ratio;
-    if (key == "latent_frames") fields >> cell->latent_frames;
+    if (key == "build_s") cell->build_s = numbers[0];
+    if (key == "solve_s") cell->solve_s = numbers[0];
+    if (key == "iterations") cell->iterations = static_cast<int>(numbers[0]);
+    if (key == "initial_cost") cell->initial_cost = numbers[0];
+    if (key == "final_cost") cell->final_cost = numbers[0];
+    if (key == "psnr") cell->psnr = numbers[0];
+    if (key == "ssim") cell->ssim = numbers[0];
+    if (key == "sharpness_ratio") cell->sharpness_ratio = numbers[0];
+    if (key == "latent_frames") cell->latent_frames = static_cast<int>(numbers[0]);
     if (key == "checkpoint") {
       Checkpoint checkpoint;
-      fields >> checkpoint.iteration >> checkpoint.time_s >> checkpoint.cost >> checkpoint.psnr >>
-          checkpoint.ssim;
+      checkpoint.iteration = static_cast<int>(numbers[0]);
+      checkpoint.time_s = numbers[1];
+      checkpoint.cost = numbers[2];
+      checkpoint.psnr = numbers[3];
+      checkpoint.ssim = numbers[4];
       cell->checkpoints.push_back(checkpoint);
     }
   }
@@ -431,7 +452,9 @@ std::string DescribeStatus(int status) {
   }
   if (WIFSIGNALED(status)) {
     return "killed by signal " + std::to_string(WTERMSIG(status)) +
-           (WTERMSIG(status) == SIGKILL ? " (out of memory?)" : "");
+           (FLAGS_cell_memory_mb > 0
+                ? " (memory limit " + std::to_string(FLAGS_cell_memory_mb) + " MB?)"
+                : "");
   }
   return "exited with status " + std::to_string(WEXITSTATUS(status)) + " and no result";
 }
@@ -440,9 +463,9 @@ std::string DescribeStatus(int status) {
 // peak resident memory.
 CellResult RunCellProcess(const Cell& cell, const std::string& result_path) {
   fs::remove(result_path);
-  std::vector<std::string> args = {
-      "/proc/self/exe", "--cell=" + cell.c.id + "," + cell.method + "," + cell.config,
-      "--cell_result=" + result_path, "--data=" + FLAGS_data};
+  std::vector<std::string> args = {"/proc/self/exe",
+                                   "--cell=" + cell.c.id + "," + cell.method + "," + cell.config,
+                                   "--cell_result=" + result_path, "--data=" + FLAGS_data};
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
@@ -452,8 +475,15 @@ CellResult RunCellProcess(const Cell& cell, const std::string& result_path) {
   const pid_t pid = fork();
   PCHECK(pid >= 0) << "fork";
   if (pid == 0) {
-    // A pending alarm survives execv: SIGALRM ends a cell that runs too long.
+    // A pending alarm, the death signal and the limits survive execv: SIGALRM ends a cell that
+    // runs too long, SIGKILL one whose parent was stopped.
     alarm(static_cast<unsigned>(FLAGS_cell_timeout_s));
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (FLAGS_cell_memory_mb > 0) {
+      const rlim_t bytes = static_cast<rlim_t>(FLAGS_cell_memory_mb) << 20;
+      const struct rlimit limit = {bytes, bytes};
+      setrlimit(RLIMIT_AS, &limit);
+    }
     execv(argv[0], argv.data());
     _exit(127);
   }
@@ -470,13 +500,19 @@ CellResult RunCellProcess(const Cell& cell, const std::string& result_path) {
   return result;
 }
 
-// The cells of `c`, in AllMethods() order; the unsupported methods with the reason go to
-// `not_run`.
-std::vector<Cell> PlanCells(const Case& c, const std::vector<Method>& methods, bool variants,
-                            std::vector<std::string>* not_run) {
+// What runs: the methods in AllMethods() order, ceres_lm in each of `ceres_configs`, and edi
+// also with its threshold tuned on the truth when `edi_oracle`.
+struct Plan {
+  std::vector<Method> methods;
+  std::vector<std::string> ceres_configs;
+  bool edi_oracle = true;
+};
+
+// The cells of `c`; the unsupported methods with the reason go to `not_run`.
+std::vector<Cell> PlanCells(const Case& c, const Plan& plan, std::vector<std::string>* not_run) {
   const Scene probe = ProbeScene(c.mode);
   std::vector<Cell> cells;
-  for (Method method : methods) {
+  for (Method method : plan.methods) {
     std::string why_not;
     if (!MethodSupports(method, probe, &why_not)) {
       not_run->push_back(std::string(MethodName(method)) + ": " + why_not);
@@ -485,14 +521,12 @@ std::vector<Cell> PlanCells(const Case& c, const std::vector<Method>& methods, b
     const auto add = [&](const std::string& config) {
       cells.push_back(Cell{c, MethodName(method), config, CellResult()});
     };
-    add(kDefaultConfig);
-    if (method == Method::kCeresLm && variants) {
-      for (const SolverConfig& config : kCeresConfigs) {
-        if (config.name != std::string(kDefaultConfig)) add(config.name);
-      }
+    if (method != Method::kCeresLm) add(kDefaultConfig);
+    if (method == Method::kCeresLm) {
+      for (const std::string& config : plan.ceres_configs) add(config);
     }
     // Only the clip deblur has both a blurred input and sharp truth frames.
-    if (method == Method::kEdi && variants && c.has_truth) add(kTunedConfig);
+    if (method == Method::kEdi && plan.edi_oracle && c.has_truth) add(kTunedConfig);
   }
   return cells;
 }
@@ -512,6 +546,19 @@ std::vector<Method> SelectedMethods() {
     }
   }
   return selected;
+}
+
+// --methods, --configs and --quick.
+Plan SelectedPlan() {
+  Plan plan;
+  plan.edi_oracle = !FLAGS_quick;
+  plan.ceres_configs =
+      FLAGS_quick ? std::vector<std::string>{kDefaultConfig} : SplitCommaList(FLAGS_configs);
+  for (const std::string& config : plan.ceres_configs) {
+    CellOptions(Method::kCeresLm, config);  // throws for an unknown configuration
+  }
+  plan.methods = SelectedMethods();
+  return plan;
 }
 
 // The machine, as `nproc` and /proc/cpuinfo's model name give it.
@@ -550,8 +597,9 @@ struct Headline {
   double reach_s = -1.0;      // ceres_lm's build + solve time to first reach it; < 0: never
   double best_psnr = 0.0;     // ceres_lm's best checkpoint
   double ceres_psnr = 0.0;    // ceres_lm's final PSNR
-  double ratio() const { return reach_s < 0 ? std::numeric_limits<double>::infinity()
-                                            : reach_s / against_time_s; }
+  double ratio() const {
+    return reach_s < 0 ? std::numeric_limits<double>::infinity() : reach_s / against_time_s;
+  }
   double psnr_difference() const { return ceres_psnr - target_psnr; }
   bool ceres_loses() const { return ratio() > 1.0 || psnr_difference() < 0.0; }
 };
@@ -595,8 +643,7 @@ std::string DescribeHeadline(const Headline& h) {
   if (h.reach_s < 0) {
     text += "never reaches it (best " + Format("%.2f dB", h.best_psnr) + ")";
   } else {
-    text += "reaches it at " + Format("%.2f s", h.reach_s) + ": ratio " +
-            Format("%.3f", h.ratio());
+    text += "reaches it at " + Format("%.2f s", h.reach_s) + ": ratio " + Format("%.3f", h.ratio());
   }
   text += "; final PSNR ceres_lm - " + h.against + " = " + Format("%+.2f dB", h.psnr_difference());
   if (h.ceres_loses()) {
@@ -619,15 +666,16 @@ struct Series {
 
 // Distinct colours (BGR), cycled.
 const cv::Scalar kPalette[] = {
-    {180, 119, 31}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},   {189, 103, 148},
-    {75, 86, 140},  {194, 119, 227}, {127, 127, 127}, {34, 189, 188}, {207, 190, 23},
-    {0, 0, 0},      {120, 200, 250},
+    {180, 119, 31},  {14, 127, 255}, {44, 160, 44},   {40, 39, 214},
+    {189, 103, 148}, {75, 86, 140},  {194, 119, 227}, {127, 127, 127},
+    {34, 189, 188},  {207, 190, 23}, {0, 0, 0},       {120, 200, 250},
 };
 
 // Times below this are drawn at it: a log axis has no zero (a baseline can take microseconds).
 constexpr double kMinPlotTimeS = 1e-3;
 
-void DrawPlot(const std::string& title, const std::string& y_label,
+// Returns false, writing nothing, when no series has a finite point.
+bool DrawPlot(const std::string& title, const std::string& y_label,
               const std::vector<Series>& series, const std::string& path) {
   constexpr int kWidth = 1100, kHeight = 650, kLeft = 80, kRight = 330, kTop = 60, kBottom = 60;
   const int plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
@@ -645,7 +693,7 @@ void DrawPlot(const std::string& title, const std::string& y_label,
     extend(s.marker);
     for (const cv::Point2d& p : s.curve) extend(p);
   }
-  if (series.empty() || !std::isfinite(t_min)) return;
+  if (series.empty() || !std::isfinite(t_min)) return false;
   const double x_lo = std::floor(std::log10(t_min));
   const double x_hi = std::max(std::ceil(std::log10(t_max)), x_lo + 1.0);
   y_min = std::floor(y_min - 0.5);
@@ -668,8 +716,8 @@ void DrawPlot(const std::string& title, const std::string& y_label,
   for (double decade = x_lo; decade <= x_hi; decade += 1.0) {
     const cv::Point bottom = to_pixel({std::pow(10.0, decade), y_min});
     cv::line(image, bottom, {bottom.x, kTop}, grid, 1);
-    cv::putText(image, Format("%g s", std::pow(10.0, decade)), {bottom.x - 20, bottom.y + 22},
-                font, 0.45, ink, 1, cv::LINE_AA);
+    cv::putText(image, Format("%g s", std::pow(10.0, decade)), {bottom.x - 20, bottom.y + 22}, font,
+                0.45, ink, 1, cv::LINE_AA);
     for (int minor = 2; minor < 10 && decade < x_hi; ++minor) {
       const cv::Point tick = to_pixel({minor * std::pow(10.0, decade), y_min});
       cv::line(image, tick, {tick.x, tick.y - 5}, ink, 1);
@@ -678,8 +726,7 @@ void DrawPlot(const std::string& title, const std::string& y_label,
   for (double y = y_min; y <= y_max + 1e-9; y += y_step) {
     const cv::Point left = to_pixel({std::pow(10.0, x_lo), y});
     cv::line(image, left, {kLeft + plot_w, left.y}, grid, 1);
-    cv::putText(image, Format("%g", y), {left.x - 40, left.y + 5}, font, 0.45, ink, 1,
-                cv::LINE_AA);
+    cv::putText(image, Format("%g", y), {left.x - 40, left.y + 5}, font, 0.45, ink, 1, cv::LINE_AA);
   }
   cv::rectangle(image, {kLeft, kTop}, {kLeft + plot_w, kTop + plot_h}, ink, 1);
   cv::putText(image, title, {kLeft, 25}, font, 0.55, ink, 1, cv::LINE_AA);
@@ -702,10 +749,10 @@ void DrawPlot(const std::string& title, const std::string& y_label,
     cv::circle(image, legend, 5, colour, cv::FILLED, cv::LINE_AA);
     cv::putText(image, s.label, {legend.x + 12, legend.y + 5}, font, 0.42, ink, 1, cv::LINE_AA);
   }
-  cv::imwrite(path, image);
+  return cv::imwrite(path, image);
 }
 
-void PlotCase(const Case& c, const std::vector<Cell>& cells, const std::string& path) {
+bool PlotCase(const Case& c, const std::vector<Cell>& cells, const std::string& path) {
   std::vector<Series> series;
   for (const Cell& cell : cells) {
     if (!cell.result.ok()) continue;
@@ -719,7 +766,7 @@ void PlotCase(const Case& c, const std::vector<Cell>& cells, const std::string& 
     }
     series.push_back(s);
   }
-  DrawPlot(c.Title(), "PSNR (dB), " + c.Score(), series, path);
+  return DrawPlot(c.Title(), "PSNR (dB), " + c.Score(), series, path);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -752,8 +799,8 @@ std::string TableRow(const Cell& cell) {
   const std::string second =
       cell.c.has_truth ? Format("%.4f", r.ssim) : Format("x%.2f", r.sharpness_ratio);
   return "| " + cell.method + " | " + cell.config + " | " + Format("%.2f s", r.time_s()) + " | " +
-         std::to_string(r.iterations) + " | " + Format("%.2f dB", r.psnr) + " | " + second +
-         " | " + Format("%.0f MB", r.peak_memory_mb) + " | " + WallAndCpu(r) + " |\n";
+         std::to_string(r.iterations) + " | " + Format("%.2f dB", r.psnr) + " | " + second + " | " +
+         Format("%.0f MB", r.peak_memory_mb) + " | " + WallAndCpu(r) + " |\n";
 }
 
 struct CaseReport {
@@ -761,6 +808,7 @@ struct CaseReport {
   std::vector<Cell> cells;
   std::vector<std::string> not_run;
   std::vector<Headline> headlines;
+  std::string plot;  // file name of the PSNR-against-time plot in --out; empty: none
 };
 
 void WriteCsv(const std::vector<CaseReport>& reports, const fs::path& out) {
@@ -775,17 +823,15 @@ void WriteCsv(const std::vector<CaseReport>& reports, const fs::path& out) {
       const CellResult& r = cell.result;
       csv << cell.c.id << "," << cell.c.data << "," << ModeName(cell.c.mode) << ","
           << CsvQuoted(cell.c.Score()) << "," << cell.method << "," << cell.config << ","
-          << CsvQuoted(r.status) << "," << r.time_s() << "," << r.build_s << "," << r.solve_s
-          << "," << r.iterations << "," << r.initial_cost << "," << r.final_cost << "," << r.psnr
-          << "," << r.ssim << "," << r.sharpness_ratio << "," << r.latent_frames << ","
-          << r.peak_memory_mb << "," << r.wall_s << "," << r.cpu_s << "," << CsvQuoted(r.note)
-          << "\n";
+          << CsvQuoted(r.status) << "," << r.time_s() << "," << r.build_s << "," << r.solve_s << ","
+          << r.iterations << "," << r.initial_cost << "," << r.final_cost << "," << r.psnr << ","
+          << r.ssim << "," << r.sharpness_ratio << "," << r.latent_frames << "," << r.peak_memory_mb
+          << "," << r.wall_s << "," << r.cpu_s << "," << CsvQuoted(r.note) << "\n";
       for (const Checkpoint& checkpoint : r.checkpoints) {
         // Time as in methods.csv: build + solve so far.
         checkpoints << cell.c.id << "," << cell.method << "," << cell.config << ","
                     << checkpoint.iteration << "," << r.build_s + checkpoint.time_s << ","
-                    << checkpoint.cost << "," << checkpoint.psnr << "," << checkpoint.ssim
-                    << "\n";
+                    << checkpoint.cost << "," << checkpoint.psnr << "," << checkpoint.ssim << "\n";
       }
     }
   }
@@ -797,17 +843,23 @@ std::string Markdown(const std::vector<CaseReport>& reports, const std::string& 
   md += "Machine: " + machine + ". Total " + Format("%.0f s", total_s) + " for the run below.\n\n";
   md += "Command: `method_benchmark --data=" + FLAGS_data + " --out=" + FLAGS_out +
         (FLAGS_quick ? " --quick" : "") +
-        (FLAGS_methods.empty() ? "" : " --methods=" + FLAGS_methods) + "`; cases: " + cases;
+        (FLAGS_methods.empty() ? "" : " --methods=" + FLAGS_methods) +
+        (FLAGS_quick ? "" : " --configs=" + FLAGS_configs) + "`; cases: " + cases;
   if (cases.find("clip_") != std::string::npos) {
     md += "; clips: " + FLAGS_clips + " (" + kClipsDefaultNote + ")";
   }
   md += ".\n\n";
-  md += "time: the method's build + solve (problem construction or objective set-up, and the "
-        "iterations; without reading the data, simulating events and scoring checkpoints). cell "
-        "wall / CPU: the whole child process, its wall time and its user + system CPU time (the "
-        "solvers use 2 threads; other load on the machine stretches the wall time, barely the "
-        "CPU time). peak memory: the child's maximum resident set size. "
-        "ceres_lm configurations: ";
+  md +=
+      "time: the method's build + solve (problem construction or objective set-up, and the "
+      "iterations; without reading the data, simulating events and scoring checkpoints). cell "
+      "wall / CPU: the whole child process, its wall time and its user + system CPU time (the "
+      "solvers use 2 threads; other load on the machine stretches the wall time, barely the "
+      "CPU time). peak memory: the child's maximum resident set size. Each cell may run " +
+      std::to_string(FLAGS_cell_timeout_s) + " s and address " +
+      (FLAGS_cell_memory_mb > 0 ? std::to_string(FLAGS_cell_memory_mb) + " MB"
+                                : std::string("unlimited memory")) +
+      ". "
+      "ceres_lm configurations: ";
   for (const SolverConfig& config : kCeresConfigs) {
     md += std::string(config.name) + " = " + config.description + "; ";
   }
@@ -823,14 +875,15 @@ std::string Markdown(const std::vector<CaseReport>& reports, const std::string& 
       for (const std::string& line : report.not_run) md += line + "; ";
       md += "\n";
     }
-    md += "\n![PSNR against time](psnr_time_" + report.c.FileStem() + ".png)\n";
+    if (!report.plot.empty()) md += "\n![PSNR against time](" + report.plot + ")\n";
   }
-  md += "\n## Headline: ceres_lm (default) against Adam\n\n"
-        "ratio: the time ceres_lm needs to first reach the Adam run's final PSNR (its build + "
-        "solve time at that checkpoint) over the Adam run's build + solve time; below 1 Ceres is "
-        "faster.\n\n"
-        "| case | against | Adam final PSNR | Adam time | ceres_lm reaches it at | ratio | "
-        "ceres_lm final PSNR | difference | verdict |\n|---|---|---|---|---|---|---|---|---|\n";
+  md +=
+      "\n## Headline: ceres_lm (default) against Adam\n\n"
+      "ratio: the time ceres_lm needs to first reach the Adam run's final PSNR (its build + "
+      "solve time at that checkpoint) over the Adam run's build + solve time; below 1 Ceres is "
+      "faster.\n\n"
+      "| case | against | Adam final PSNR | Adam time | ceres_lm reaches it at | ratio | "
+      "ceres_lm final PSNR | difference | verdict |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const CaseReport& report : reports) {
     for (const Headline& h : report.headlines) {
       md += "| " + report.c.id + " | " + h.against + " | " + Format("%.2f dB", h.target_psnr) +
@@ -851,21 +904,22 @@ int RunParent() {
     return 2;
   }
   if (FLAGS_cell_timeout_s <= 0) throw InvalidArgumentError("--cell_timeout_s must be > 0");
-  const bool variants = !FLAGS_quick;
+  if (FLAGS_cell_memory_mb < 0) throw InvalidArgumentError("--cell_memory_mb must be >= 0");
   const std::string cases = FLAGS_quick ? "slider_predict,shapes_interpolate" : FLAGS_cases;
-  const std::vector<Method> methods = SelectedMethods();
+  const Plan plan = SelectedPlan();
   const fs::path out(FLAGS_out);
   fs::create_directories(out);
   const std::string result_path = (out / ".cell_result.txt").string();
+  const std::vector<Case> selected = SelectedCases(cases, FLAGS_clips);
   const std::string machine = MachineLine();
   std::printf("machine: %s\n", machine.c_str());
   const auto start = Clock::now();
 
   std::vector<CaseReport> reports;
-  for (const Case& c : SelectedCases(cases, FLAGS_clips)) {
+  for (const Case& c : selected) {
     CaseReport report;
     report.c = c;
-    report.cells = PlanCells(c, methods, variants, &report.not_run);
+    report.cells = PlanCells(c, plan, &report.not_run);
     std::printf("\n## %s\n\n%s", c.Title().c_str(), TableHeader(c).c_str());
     for (Cell& cell : report.cells) {
       cell.result = RunCellProcess(cell, result_path);
@@ -873,7 +927,8 @@ int RunParent() {
       std::fflush(stdout);
     }
     report.headlines = Headlines(report.cells);
-    PlotCase(c, report.cells, (out / ("psnr_time_" + c.FileStem() + ".png")).string());
+    const std::string plot = "psnr_time_" + c.FileStem() + ".png";
+    if (PlotCase(c, report.cells, (out / plot).string())) report.plot = plot;
     reports.push_back(std::move(report));
   }
   const double total_s = SecondsSince(start);
@@ -886,9 +941,10 @@ int RunParent() {
       std::printf("%s: %s\n", report.c.id.c_str(), DescribeHeadline(h).c_str());
     }
   }
-  std::printf("\ntotal %.0f s; wrote %s/{methods.csv,methods_checkpoints.csv,methods.md,"
-              "psnr_time_*.png}\n",
-              total_s, out.string().c_str());
+  std::printf(
+      "\ntotal %.0f s; wrote %s/{methods.csv,methods_checkpoints.csv,methods.md,"
+      "psnr_time_*.png}\n",
+      total_s, out.string().c_str());
   return 0;
 }
 

@@ -19,6 +19,7 @@
 #include "benchmarks/benchmark_cases.h"
 #include "core/error.h"
 #include "core/metrics.h"
+#include "core/time.h"
 #include "examples/reconstruct_job.h"
 #include "solver/reconstructor.h"
 
@@ -77,10 +78,6 @@ BinningOptions Binning() {
   BinningOptions binning;
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   return binning;
-}
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 // PSNR rows compare by difference, other rows (sharpness) by ratio; rows without a baseline
