@@ -38,6 +38,8 @@ DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight, "
 DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight, "lambda_xy.");
 DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
             "one unknown per quiet run of a pixel (false: per voxel).");
+DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
+            "solve uncoupled regions as separate concurrent problems (false: one problem).");
 DEFINE_string(init, "blend", "blend | events: where the solve starts.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "auto binning's voxel budget.");
@@ -71,6 +73,7 @@ ReconstructionOptions Options() {
   options.objective.event_weight = FLAGS_event_weight;
   options.objective.temporal_tv_weight = FLAGS_temporal_tv_weight;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
+  options.split_independent_parts = FLAGS_split_independent_parts;
   return options;
 }
 

@@ -92,6 +92,9 @@ DEFINE_string(init, evfs::InitializationName(evfs::MethodOptions().initializatio
 DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps, "Hold a pixel "
             "constant between the latent steps where it fired (one unknown per quiet run); "
             "false: one unknown per voxel.");
+DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
+            "Solve the regions that no term couples as separate problems, concurrently "
+            "(one after another with --progress or --checkpoints); false: one problem.");
 // Ceres.
 DEFINE_string(linear_solver, "CGNR", "Ceres linear solver: CGNR | SPARSE_NORMAL_CHOLESKY | "
               "ITERATIVE_SCHUR | DENSE_QR ...");
@@ -288,6 +291,7 @@ ReconstructRequest RequestFromFlags() {
   options.bound_intensities = FLAGS_bounds;
   options.activity_radius_px = FLAGS_activity_radius_px;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
+  options.split_independent_parts = FLAGS_split_independent_parts;
 
   ceres::Solver::Options& solver = options.solver;
   Require(ceres::StringToLinearSolverType(FLAGS_linear_solver, &solver.linear_solver_type),

@@ -261,6 +261,8 @@ void WriteProblem(const ReconstructionOptions& options, const ProblemStatistics&
   json->Field("merge_quiet_steps", options.merge_quiet_steps);
   json->EndObject();
   json->Key("problem").BeginObject();
+  json->Field("independent_parts", problem.parts);
+  json->Field("split_independent_parts", options.split_independent_parts);
   json->Field("parameter_blocks", problem.parameter_blocks);
   json->Field("unknowns", problem.variable_parameter_blocks);
   json->Field("residual_blocks", problem.residual_blocks());

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <opencv2/imgproc.hpp>
+
 namespace evfs {
 namespace {
 
@@ -30,8 +32,9 @@ std::vector<uint8_t> Dilate(const std::vector<uint8_t>& mask, int height, int wi
 
 }  // namespace
 
-ActivityMask::ActivityMask(const EventFrames& events, int radius_px) {
-  const int height = events.height(), width = events.width();
+ActivityMask::ActivityMask(const EventFrames& events, int radius_px)
+    : height_(events.height()), width_(events.width()) {
+  const int height = height_, width = width_;
   const int64_t pixels = static_cast<int64_t>(height) * width;
   if (radius_px < 0) {
     roles_.assign(pixels, Role::kActive);
@@ -50,6 +53,32 @@ ActivityMask::ActivityMask(const EventFrames& events, int radius_px) {
     roles_[p] = active[p] ? Role::kActive : near_active[p] ? Role::kRing : Role::kInactive;
     num_active_ += active[p];
   }
+}
+
+std::vector<std::vector<int64_t>> ActivityMask::IndependentParts(int64_t min_part_pixels) const {
+  cv::Mat in_problem(height_, width_, CV_8U);
+  for (int64_t p = 0; p < num_pixels(); ++p) in_problem.data[p] = roles_[p] != Role::kInactive;
+  cv::Mat labels;
+  const int count = cv::connectedComponents(in_problem, labels, 8, CV_32S);
+  std::vector<std::vector<int64_t>> components(std::max(0, count - 1));  // label 0: background
+  const int32_t* label = labels.ptr<int32_t>();
+  for (int64_t p = 0; p < num_pixels(); ++p) {
+    if (label[p] > 0) components[label[p] - 1].push_back(p);
+  }
+  std::stable_sort(components.begin(), components.end(),
+                   [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  std::vector<std::vector<int64_t>> parts;
+  bool packing = false;  // the last part collects small components
+  for (std::vector<int64_t>& component : components) {
+    if (packing && static_cast<int64_t>(parts.back().size()) < min_part_pixels) {
+      parts.back().insert(parts.back().end(), component.begin(), component.end());
+    } else {
+      packing = static_cast<int64_t>(component.size()) < min_part_pixels;
+      parts.push_back(std::move(component));
+    }
+  }
+  for (std::vector<int64_t>& part : parts) std::sort(part.begin(), part.end());
+  return parts;
 }
 
 }  // namespace evfs

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "cost_functions/difference_residual.h"
 #include "cost_functions/event_residual.h"
 #include "cost_functions/frame_residual.h"
@@ -67,25 +68,77 @@ class LossCache {
 
 }  // namespace
 
+ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) {
+  parameter_blocks += part.parameter_blocks;
+  variable_parameter_blocks += part.variable_parameter_blocks;
+  frame_residuals += part.frame_residuals;
+  event_residuals += part.event_residuals;
+  spatial_tv_residuals += part.spatial_tv_residuals;
+  temporal_tv_residuals += part.temporal_tv_residuals;
+  distinct_cost_functions += part.distinct_cost_functions;
+  active_pixels += part.active_pixels;
+  skipped_pixels += part.skipped_pixels;
+  parts += part.parts;
+  return *this;
+}
+
+// What every part of a scene shares: which pixels are solved for and how their time series are
+// cut into segments.
+struct ProblemBuilder::Prepared {
+  std::unique_ptr<ActivityMask> mask;
+  std::shared_ptr<const LatentLayout> layout;
+};
+
 ProblemBuilder::ProblemBuilder(const Scene& scene, const ReconstructionOptions& options)
     : scene_(scene), options_(options) {}
 
-std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
-  const int num_latent = scene_.num_latent_frames();
-  const int height = scene_.height, width = scene_.width;
-  if (latent->num_frames() != num_latent || latent->height() != height ||
-      latent->width() != width) {
+ProblemBuilder::Prepared ProblemBuilder::Prepare(Video* latent) const {
+  if (latent->num_frames() != scene_.num_latent_frames() || latent->height() != scene_.height ||
+      latent->width() != scene_.width) {
     throw InvalidArgumentError("the latent video does not match the scene's size");
   }
+  Prepared prepared;
+  prepared.mask = std::make_unique<ActivityMask>(scene_.events, options_.activity_radius_px);
+  auto layout =
+      std::make_shared<LatentLayout>(scene_, *prepared.mask, *latent, options_.merge_quiet_steps);
+  layout->ProjectOnto(latent);
+  prepared.layout = std::move(layout);
+  return prepared;
+}
+
+std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
+  const Prepared prepared = Prepare(latent);
+  std::vector<int64_t> pixels;
+  for (int64_t p = 0; p < prepared.mask->num_pixels(); ++p) {
+    if (prepared.mask->in_problem(p)) pixels.push_back(p);
+  }
+  std::unique_ptr<BuiltProblem> built = BuildPart(prepared, pixels, latent);
+  built->statistics_.skipped_pixels = prepared.mask->num_pixels() - prepared.mask->num_active();
+  return built;
+}
+
+std::vector<std::unique_ptr<BuiltProblem>> ProblemBuilder::BuildParts(Video* latent,
+                                                                      int build_workers) const {
+  const Prepared prepared = Prepare(latent);
+  const std::vector<std::vector<int64_t>> parts =
+      prepared.mask->IndependentParts(options_.min_part_pixels);
+  std::vector<std::unique_ptr<BuiltProblem>> built(parts.size());
+  ParallelForEach(static_cast<int>(parts.size()), build_workers,
+                  [&](int i) { built[i] = BuildPart(prepared, parts[i], latent); });
+  return built;
+}
+
+std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared,
+                                                        const std::vector<int64_t>& pixels,
+                                                        Video* latent) const {
   const ObjectiveOptions& objective = options_.objective;
-  const int64_t pixels = latent->pixels_per_frame();
+  const ActivityMask& mask = *prepared.mask;
+  const LatentLayout& layout = *prepared.layout;
+  const int num_latent = scene_.num_latent_frames();
+  const int width = scene_.width, height = scene_.height;
 
   auto built = std::make_unique<BuiltProblem>();
-  const ActivityMask mask(scene_.events, options_.activity_radius_px);
-  built->layout_ = std::make_unique<LatentLayout>(scene_, mask, *latent, options_.merge_quiet_steps);
-  const LatentLayout& layout = *built->layout_;
-  layout.ProjectOnto(latent);
-
+  built->layout_ = prepared.layout;
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -99,23 +152,33 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   CostFunctionCache cache(&built->cost_functions_);
   LossCache losses(&built->losses_, objective.smoothing_scale);
 
-  for (int64_t s = 0; s < layout.num_segments(); ++s) {
-    double* value = layout.value(s, latent);
-    problem.AddParameterBlock(value, 1);
-    if (layout.segment(s).constant) {
-      problem.SetParameterBlockConstant(value);
-    } else if (options_.bound_intensities) {
-      problem.SetParameterLowerBound(value, 0, 0.0);
-      problem.SetParameterUpperBound(value, 0, 1.0);
+  // The segments of pixel p are consecutive in the layout, from its first frame's.
+  const auto for_each_segment = [&](int64_t p, const auto& visit) {
+    for (int64_t s = layout.segment_at(0, p);
+         s < layout.num_segments() && layout.segment(s).pixel == p; ++s) {
+      visit(s);
     }
+  };
+  for (const int64_t p : pixels) {
+    statistics.active_pixels += mask.active(p);
+    for_each_segment(p, [&](int64_t s) {
+      double* value = layout.value(s, latent);
+      problem.AddParameterBlock(value, 1);
+      ++statistics.parameter_blocks;
+      if (layout.segment(s).constant) {
+        problem.SetParameterBlockConstant(value);
+        return;
+      }
+      ++statistics.variable_parameter_blocks;
+      if (options_.bound_intensities) {
+        problem.SetParameterLowerBound(value, 0, 0.0);
+        problem.SetParameterUpperBound(value, 0, 1.0);
+      }
+    });
   }
-  statistics.parameter_blocks = layout.num_segments();
-  statistics.variable_parameter_blocks = layout.num_variable_segments();
-  statistics.active_pixels = mask.num_active();
-  statistics.skipped_pixels = pixels - mask.num_active();
 
   // Each family's loss is weight / (h·w) times the smoothed |r| (ObjectiveOptions).
-  const double per_pixel = 1.0 / static_cast<double>(pixels);
+  const double per_pixel = 1.0 / static_cast<double>(layout.pixels_per_frame());
   const auto block = [&](int t, int64_t p) { return layout.value(layout.segment_at(t, p), latent); };
   using Family = CostFunctionCache::Family;
   std::vector<double*> blocks;
@@ -124,7 +187,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   if (objective.frame_weight > 0.0) {
     ceres::LossFunction* loss = losses.Get(objective.frame_weight * per_pixel, 1);
     for (const FrameObservation& frame : scene_.frames) {
-      for (int64_t p = 0; p < pixels; ++p) {
+      for (const int64_t p : pixels) {
         if (!mask.active(p)) continue;
         // The exposure's voxels, one block per run of a segment.
         blocks.clear();
@@ -154,7 +217,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
       const EventFrameSpan& span = scene_.events.span(k);
       const int steps = span.latent_last - span.latent_first;
       const float* values = scene_.events.frame_data(k);
-      for (int64_t p = 0; p < pixels; ++p) {
+      for (const int64_t p : pixels) {
         if (!mask.active(p)) continue;
         // Over merged steps H does not change and the model predicts 0: a step contributes
         // only where a segment starts. The layout starts one at every step of a frame that
@@ -210,21 +273,20 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
         run_first = t;
       }
     };
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const int64_t p = static_cast<int64_t>(y) * width + x;
-        // A term is built when any pixel it touches is active; the others are then ring
-        // pixels, held constant.
-        const bool has_right = x + 1 < width, has_below = y + 1 < height;
-        const bool here = mask.active(p);
-        const bool right = has_right && mask.active(p + 1);
-        const bool below = has_below && mask.active(p + width);
-        if (anisotropic) {
-          if (has_right && (here || right)) add_runs({p, p + 1});
-          if (has_below && (here || below)) add_runs({p, p + width});
-        } else if (has_right && has_below && (here || right || below)) {
-          add_runs({p, p + 1, p + width});
-        }
+    // A term is built when any pixel it touches is active; the others are then in the problem
+    // (within one pixel of an active one) and in the same part, and the term is built by the
+    // part of its top-left pixel.
+    for (const int64_t p : pixels) {
+      const int y = static_cast<int>(p / width), x = static_cast<int>(p % width);
+      const bool has_right = x + 1 < width, has_below = y + 1 < height;
+      const bool here = mask.active(p);
+      const bool right = has_right && mask.active(p + 1);
+      const bool below = has_below && mask.active(p + width);
+      if (anisotropic) {
+        if (has_right && (here || right)) add_runs({p, p + 1});
+        if (has_below && (here || below)) add_runs({p, p + width});
+      } else if (has_right && has_below && (here || right || below)) {
+        add_runs({p, p + 1, p + width});
       }
     }
   }
@@ -234,12 +296,16 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
     ceres::LossFunction* loss = losses.Get(objective.temporal_tv_weight * per_pixel, 1);
     ceres::CostFunction* difference =
         cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
-    for (int64_t s = 0; s + 1 < layout.num_segments(); ++s) {
-      const LatentLayout::Segment& segment = layout.segment(s);
-      if (segment.constant || layout.segment(s + 1).pixel != segment.pixel) continue;
-      problem.AddResidualBlock(difference, loss, layout.value(s, latent),
-                               layout.value(s + 1, latent));
-      ++statistics.temporal_tv_residuals;
+    for (const int64_t p : pixels) {
+      for_each_segment(p, [&](int64_t s) {
+        if (layout.segment(s).constant || s + 1 >= layout.num_segments() ||
+            layout.segment(s + 1).pixel != p) {
+          return;
+        }
+        problem.AddResidualBlock(difference, loss, layout.value(s, latent),
+                                 layout.value(s + 1, latent));
+        ++statistics.temporal_tv_residuals;
+      });
     }
   }
   statistics.distinct_cost_functions = static_cast<int64_t>(built->cost_functions_.size());

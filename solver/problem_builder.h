@@ -28,10 +28,13 @@ struct ProblemStatistics {
   int64_t distinct_cost_functions = 0;
   int64_t active_pixels = 0;   // pixels whose time series is solved for
   int64_t skipped_pixels = 0;  // pixels left at their initial value (ActivityMask)
+  int64_t parts = 1;           // independent problems (ActivityMask::IndependentParts)
 
   int64_t residual_blocks() const {
     return frame_residuals + event_residuals + spatial_tv_residuals + temporal_tv_residuals;
   }
+  /// Sums the counts of another part of the same scene.
+  ProblemStatistics& operator+=(const ProblemStatistics& part);
 };
 
 /// A Ceres problem together with the cost and loss functions it refers to. The problem does not
@@ -41,12 +44,13 @@ class BuiltProblem {
  public:
   ceres::Problem& problem() { return *problem_; }
   const ProblemStatistics& statistics() const { return statistics_; }
-  /// Which voxels the parameter blocks stand for; Expand() the latent video after a solve.
+  /// Which voxels the parameter blocks stand for (shared by every part of a scene); Expand()
+  /// the latent video after a solve.
   const LatentLayout& layout() const { return *layout_; }
 
  private:
   friend class ProblemBuilder;
-  std::unique_ptr<LatentLayout> layout_;
+  std::shared_ptr<const LatentLayout> layout_;
   std::vector<std::unique_ptr<ceres::CostFunction>> cost_functions_;
   std::vector<std::unique_ptr<ceres::LossFunction>> losses_;
   std::unique_ptr<ceres::Problem> problem_;  // declared last: destroyed before the functions
@@ -69,7 +73,18 @@ class ProblemBuilder {
   /// solve, built->layout().Expand(latent) writes the solution to every voxel.
   std::unique_ptr<BuiltProblem> Build(Video* latent) const;
 
+  /// The same objective as independent problems, one per ActivityMask::IndependentParts(
+  /// options.min_part_pixels), sharing one layout and writing disjoint voxels of `latent`: they
+  /// may be solved concurrently, and their costs add up to Build()'s. Parts by decreasing size;
+  /// `build_workers` threads build them.
+  std::vector<std::unique_ptr<BuiltProblem>> BuildParts(Video* latent, int build_workers) const;
+
  private:
+  struct Prepared;
+  Prepared Prepare(Video* latent) const;
+  std::unique_ptr<BuiltProblem> BuildPart(const Prepared& prepared,
+                                          const std::vector<int64_t>& pixels, Video* latent) const;
+
   const Scene& scene_;
   const ReconstructionOptions& options_;
 };

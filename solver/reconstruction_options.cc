@@ -101,6 +101,10 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
              "off or use the trust-region minimiser";
     return false;
   }
+  if (min_part_pixels < 1) {
+    *error = "min_part_pixels must be at least 1";
+    return false;
+  }
   return solver.IsValid(error);
 }
 

@@ -68,6 +68,15 @@ struct ReconstructionOptions {
   /// changes and the problem is several times smaller). False: one unknown per voxel.
   bool merge_quiet_steps = true;
 
+  /// Solve separately, on solver.num_threads threads, the parts of the scene that no term
+  /// couples (ActivityMask::IndependentParts): each stops at its own convergence and the
+  /// threads share the work. With an iteration callback the parts are solved one after another
+  /// (the callback sees the whole latent video). False: one problem.
+  bool split_independent_parts = true;
+  /// Independent regions smaller than this (pixels) are packed into one part: a Ceres solve has
+  /// a fixed cost of about a millisecond.
+  int64_t min_part_pixels = 1024;
+
   /// Ceres settings, all of them available to library users; the defaults below are set by
   /// DefaultSolverOptions() (Levenberg–Marquardt, CGNR with a Jacobi preconditioner).
   ceres::Solver::Options solver;

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <vector>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/time.h"
 
 namespace evfs {
@@ -14,26 +16,41 @@ using Clock = std::chrono::steady_clock;
 
 // Hands each Ceres iteration to an IterationCallback with the whole latent video: Ceres writes
 // the segment values (update_state_every_iteration), the layout spreads them over their voxels.
+// Parts are solved one after another under one adapter: it reports the whole objective (the
+// parts done at their final cost, those to come at their initial one) and counts iterations
+// across parts.
 class CallbackAdapter : public ceres::IterationCallback {
  public:
   CallbackAdapter(const evfs::IterationCallback& callback, const LatentLayout& layout,
                   Video* latent)
       : callback_(callback), layout_(layout), latent_(latent), start_(Clock::now()) {}
 
+  /// Before each part's solve: the cost of every other part, and whether this is the first.
+  void StartPart(double other_parts_cost, bool first) {
+    other_parts_cost_ = other_parts_cost;
+    first_part_ = first;
+    iteration_base_ = iteration_;
+  }
+
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    // Ceres reports each part's starting point as iteration 0; only the first one is new.
+    if (summary.iteration == 0 && !first_part_) return ceres::SOLVER_CONTINUE;
     const auto call_start = Clock::now();
     layout_.Expand(latent_);
+    iteration_ = iteration_base_ + summary.iteration;
     SolverIteration iteration;
-    iteration.iteration = summary.iteration;
-    iteration.cost = summary.cost;
+    iteration.iteration = iteration_;
+    iteration.cost = other_parts_cost_ + summary.cost;
     iteration.elapsed_s = SecondsSince(start_) - time_in_callback_s_;
     iteration.latent = latent_;
     const bool go_on = callback_(iteration);
     time_in_callback_s_ += SecondsSince(call_start);
+    stopped_ = !go_on;
     return go_on ? ceres::SOLVER_CONTINUE : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
 
   double time_in_callback_s() const { return time_in_callback_s_; }
+  bool stopped() const { return stopped_; }
 
  private:
   const evfs::IterationCallback& callback_;
@@ -41,7 +58,48 @@ class CallbackAdapter : public ceres::IterationCallback {
   Video* latent_;
   const Clock::time_point start_;
   double time_in_callback_s_ = 0.0;
+  double other_parts_cost_ = 0.0;
+  bool first_part_ = true;
+  int iteration_ = 0;
+  int iteration_base_ = 0;
+  bool stopped_ = false;
 };
+
+// Adds a part's Ceres summary to the whole scene's: costs, steps and stage times add up; the
+// worst termination wins (with its message), otherwise the first (largest) part's message.
+void Accumulate(const ceres::Solver::Summary& part, bool first, ceres::Solver::Summary* total) {
+  const auto severity = [](ceres::TerminationType type) {
+    return type == ceres::FAILURE ? 2 : type == ceres::NO_CONVERGENCE ? 1 : 0;
+  };
+  if (first) {
+    *total = part;
+    return;
+  }
+  if (severity(part.termination_type) > severity(total->termination_type)) {
+    total->termination_type = part.termination_type;
+    total->message = part.message;
+  }
+  total->initial_cost += part.initial_cost;
+  total->final_cost += part.final_cost;
+  total->fixed_cost += part.fixed_cost;
+  total->num_successful_steps += part.num_successful_steps;
+  total->num_unsuccessful_steps += part.num_unsuccessful_steps;
+  total->preprocessor_time_in_seconds += part.preprocessor_time_in_seconds;
+  total->minimizer_time_in_seconds += part.minimizer_time_in_seconds;
+  total->postprocessor_time_in_seconds += part.postprocessor_time_in_seconds;
+  total->total_time_in_seconds += part.total_time_in_seconds;
+  total->residual_evaluation_time_in_seconds += part.residual_evaluation_time_in_seconds;
+  total->jacobian_evaluation_time_in_seconds += part.jacobian_evaluation_time_in_seconds;
+  total->linear_solver_time_in_seconds += part.linear_solver_time_in_seconds;
+  total->num_parameter_blocks += part.num_parameter_blocks;
+  total->num_residual_blocks += part.num_residual_blocks;
+}
+
+double InitialCost(ceres::Problem* problem) {
+  double cost = 0.0;
+  problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+  return cost;
+}
 
 }  // namespace
 
@@ -85,33 +143,89 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     return result;
   }
 
+  const int threads = std::max(1, solve_options.solver.num_threads);
   const auto build_start = Clock::now();
-  const std::unique_ptr<BuiltProblem> built = ProblemBuilder(scene, solve_options).Build(&result.video);
+  const ProblemBuilder builder(scene, solve_options);
+  std::vector<std::unique_ptr<BuiltProblem>> parts;
+  if (options.split_independent_parts) {
+    parts = builder.BuildParts(&result.video, threads);
+  } else {
+    parts.push_back(builder.Build(&result.video));
+  }
   summary.build_time_s = SecondsSince(build_start);
-  summary.problem = built->statistics();
+  summary.problem = ProblemStatistics();
+  summary.problem.parts = 0;
+  for (const auto& part : parts) summary.problem += part->statistics();
+  summary.problem.skipped_pixels = static_cast<int64_t>(scene.height) * scene.width -
+                                   summary.problem.active_pixels;
   if (summary.problem.variable_parameter_blocks == 0) {
     summary.skipped_reason = "no unknowns: no pixel is active";
     return result;
   }
 
-  std::unique_ptr<CallbackAdapter> adapter;
-  if (callback) {
-    adapter = std::make_unique<CallbackAdapter>(callback, built->layout(), &result.video);
-    solve_options.solver.callbacks.push_back(adapter.get());
-    solve_options.solver.update_state_every_iteration = true;
-  }
+  std::vector<ceres::Solver::Summary> part_summaries(parts.size());
   const auto solve_start = Clock::now();
-  ceres::Solve(solve_options.solver, &built->problem(), &summary.ceres);
-  summary.solve_time_s =
-      SecondsSince(solve_start) - (adapter ? adapter->time_in_callback_s() : 0.0);
+  // Ceres stops when an iteration changes the cost by less than function_tolerance times the
+  // cost. A part is held to the same absolute change as the whole problem would be: its
+  // tolerance is scaled by the whole initial cost over its own, so that a small region stops
+  // once its progress no longer matters to the objective instead of iterating on its own
+  // noise.
+  std::vector<double> costs(parts.size(), 0.0);
+  if (parts.size() > 1) {
+    ParallelForEach(static_cast<int>(parts.size()), threads,
+                    [&](int i) { costs[i] = InitialCost(&parts[i]->problem()); });
+  }
+  double total_cost = 0.0;
+  for (const double cost : costs) total_cost += cost;
+  const auto part_options = [&](size_t i, int part_threads) {
+    ceres::Solver::Options part = solve_options.solver;
+    part.num_threads = part_threads;
+    if (parts.size() > 1 && costs[i] > 0.0) part.function_tolerance *= total_cost / costs[i];
+    return part;
+  };
+  double time_in_callback_s = 0.0;
+  if (callback) {
+    // One after another, each with every thread, so that the callback sees a whole video.
+    CallbackAdapter adapter(callback, parts.front()->layout(), &result.video);
+    for (size_t i = 0; i < parts.size() && !adapter.stopped(); ++i) {
+      double others = 0.0;
+      for (size_t j = 0; j < parts.size(); ++j) others += j == i ? 0.0 : costs[j];
+      adapter.StartPart(others, i == 0);
+      ceres::Solver::Options options_i = part_options(i, threads);
+      options_i.callbacks.push_back(&adapter);
+      options_i.update_state_every_iteration = true;
+      ceres::Solve(options_i, &parts[i]->problem(), &part_summaries[i]);
+      costs[i] = part_summaries[i].final_cost;
+    }
+    time_in_callback_s = adapter.time_in_callback_s();
+    // Parts left when the callback stopped the solve stay at their start.
+    for (size_t i = 0; i < parts.size(); ++i) {
+      if (!part_summaries[i].iterations.empty()) continue;
+      part_summaries[i].termination_type = ceres::USER_SUCCESS;
+      part_summaries[i].initial_cost = part_summaries[i].final_cost = costs[i];
+    }
+  } else {
+    // Largest first, each worker taking the next part as it becomes free; Ceres' own threads
+    // split what remains.
+    const int workers = std::min<int>(threads, static_cast<int>(parts.size()));
+    ParallelForEach(static_cast<int>(parts.size()), workers, [&](int i) {
+      ceres::Solve(part_options(i, std::max(1, threads / workers)), &parts[i]->problem(),
+                   &part_summaries[i]);
+    });
+  }
+  summary.solve_time_s = SecondsSince(solve_start) - time_in_callback_s;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    Accumulate(part_summaries[i], i == 0, &summary.ceres);
+    summary.iterations = std::max(
+        summary.iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
+  }
   if (summary.ceres.termination_type == ceres::FAILURE) {
     throw InvalidArgumentError("the solve failed: " + summary.ceres.message);
   }
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
-  summary.iterations = std::max(0, static_cast<int>(summary.ceres.iterations.size()) - 1);
-  built->layout().Expand(&result.video);
+  parts.front()->layout().Expand(&result.video);
   return result;
 }
 

@@ -17,6 +17,8 @@ namespace evfs {
 
 /// What a reconstruction did: Ceres' own summary plus evfs' counts and timings.
 struct ReconstructionSummary {
+  /// Ceres' summary; with several independent parts, their costs, steps and stage times
+  /// summed (stage times are then thread time, not wall time) and the worst termination.
   ceres::Solver::Summary ceres;
   ProblemStatistics problem;
   EventModelEstimate model;    // the α used, and how it was derived when it was
@@ -27,7 +29,7 @@ struct ReconstructionSummary {
   double solve_time_s = 0.0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
-  int iterations = 0;
+  int iterations = 0;  // of the part that took most
 };
 
 struct Reconstruction {

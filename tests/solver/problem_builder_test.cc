@@ -1,6 +1,7 @@
 #include "solver/problem_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -24,6 +25,21 @@ Scene MakeTinyScene() {
   scene.num_events = 1;
   scene.frames.push_back({Image::Constant(4, 5, 0.2), 0, 0, "first"});
   scene.frames.push_back({Image::Constant(4, 5, 0.6), 3, 3, "last"});
+  return scene;
+}
+
+// A height × width scene like MakeTinyScene, with one ON event per {step, y, x} given.
+Scene MakeSceneWithEvents(int height, int width, const std::vector<std::array<int, 3>>& events) {
+  Scene scene;
+  scene.height = height;
+  scene.width = width;
+  scene.events = EventFrames(height, width);
+  for (int k = 0; k < 3; ++k) scene.events.AddFrame({k, k + 1, 10 * k, 10 * k + 5, 1});
+  scene.events.set_latent_timestamps_ns({0, 10, 20, 30});
+  for (const auto& [step, y, x] : events) scene.events.value(step, y, x) = 1.0f;
+  scene.num_events = static_cast<int64_t>(events.size());
+  scene.frames.push_back({Image::Constant(height, width, 0.2), 0, 0, "first"});
+  scene.frames.push_back({Image::Constant(height, width, 0.6), 3, 3, "last"});
   return scene;
 }
 
@@ -133,6 +149,71 @@ TEST(ProblemBuilder, MergedLayoutHasOneUnknownPerQuietRun) {
   EXPECT_NEAR(latent.at(3, 0, 0), 0.4, 1e-12);
   EXPECT_NEAR(latent.at(1, 2, 3), 0.2 + 0.4 / 6.0, 1e-12);
   EXPECT_NEAR(latent.at(2, 2, 3), 0.6 - 0.4 / 6.0, 1e-12);
+}
+
+TEST(ActivityMask, IndependentPartsAreConnectedRegionsOfTheProblem) {
+  // Radius 1: events at (y 2, x 2) and (y 2, x 5) give active squares whose rings touch (one
+  // region); the event at (y 2, x 14) is far from both (a second region).
+  const Scene scene = MakeSceneWithEvents(6, 18, {{0, 2, 2}, {1, 2, 5}, {2, 2, 14}});
+  const ActivityMask mask(scene.events, 1);
+  const std::vector<std::vector<int64_t>> parts = mask.IndependentParts(1);
+  ASSERT_EQ(parts.size(), 2u);
+  // Active x 1..6 plus ring x 0..7, rows 0..4: 40 pixels; active x 13..15 plus ring: 25.
+  EXPECT_EQ(parts[0].size(), 40u);
+  EXPECT_EQ(parts[1].size(), 25u);
+  for (const auto& part : parts) {
+    EXPECT_TRUE(std::is_sorted(part.begin(), part.end()));
+    for (const int64_t p : part) EXPECT_TRUE(mask.in_problem(p));
+  }
+  EXPECT_EQ(parts[1].front(), 12);  // (y 0, x 12), the corner of the second region's ring
+  // Regions below the minimum size are packed into one part.
+  EXPECT_EQ(mask.IndependentParts(41).size(), 1u);
+  EXPECT_EQ(mask.IndependentParts(41).front().size(), 65u);
+}
+
+TEST(ProblemBuilder, PartsSplitTheWholeProblemExactly) {
+  // Every term lands in exactly one part: counts and costs add up to the one problem's.
+  const Scene scene = MakeSceneWithEvents(6, 18, {{0, 2, 2}, {1, 2, 5}, {2, 2, 14}});
+  for (const bool merge : {false, true}) {
+    for (const SpatialTv tv : {SpatialTv::kAnisotropic, SpatialTv::kPaper}) {
+      SCOPED_TRACE(std::string(merge ? "merged" : "per voxel") + ", " + SpatialTvName(tv));
+      ReconstructionOptions options;
+      options.objective.event_model.alpha = 5.0;
+      options.objective.spatial_tv = tv;
+      options.activity_radius_px = 1;
+      options.merge_quiet_steps = merge;
+      options.min_part_pixels = 1;
+      Video whole_latent = InitializeLatentVideo(scene);
+      Video parts_latent = whole_latent;
+      const ProblemBuilder builder(scene, options);
+      const auto whole = builder.Build(&whole_latent);
+      const auto parts = builder.BuildParts(&parts_latent, 2);
+      ASSERT_EQ(parts.size(), 2u);
+      ProblemStatistics sum;
+      sum.parts = 0;
+      double cost_sum = 0.0;
+      for (const auto& part : parts) {
+        sum += part->statistics();
+        double cost = 0.0;
+        part->problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr,
+                                 nullptr);
+        cost_sum += cost;
+      }
+      const ProblemStatistics& one = whole->statistics();
+      EXPECT_EQ(sum.parts, 2);
+      EXPECT_EQ(sum.parameter_blocks, one.parameter_blocks);
+      EXPECT_EQ(sum.variable_parameter_blocks, one.variable_parameter_blocks);
+      EXPECT_EQ(sum.frame_residuals, one.frame_residuals);
+      EXPECT_EQ(sum.event_residuals, one.event_residuals);
+      EXPECT_EQ(sum.spatial_tv_residuals, one.spatial_tv_residuals);
+      EXPECT_EQ(sum.temporal_tv_residuals, one.temporal_tv_residuals);
+      EXPECT_EQ(sum.active_pixels, one.active_pixels);
+      double whole_cost = 0.0;
+      whole->problem().Evaluate(ceres::Problem::EvaluateOptions(), &whole_cost, nullptr, nullptr,
+                                nullptr);
+      EXPECT_NEAR(cost_sum, whole_cost, 1e-12 * whole_cost);
+    }
+  }
 }
 
 // Cost and gradient of `problem` at its current values, the gradient in `blocks`' order.
