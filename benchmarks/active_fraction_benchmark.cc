@@ -19,6 +19,7 @@
 #include "core/metrics.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
+#include "examples/allocator_tuning.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(fractions, "0,0.05,0.1,0.25,0.5,0.75,1",
@@ -117,6 +118,7 @@ int Run() {
 }  // namespace evfs
 
 int main(int argc, char** argv) {
+  evfs::KeepFreedMemoryForReuse();
   gflags::SetUsageMessage("Reconstruction time against the active fraction of a scene.");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);

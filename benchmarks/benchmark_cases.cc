@@ -1,5 +1,6 @@
 #include "benchmarks/benchmark_cases.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -30,7 +31,8 @@ std::vector<std::string> SplitCommaList(const std::string& list) {
   return items;
 }
 
-SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& name) {
+SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& name,
+                                int crop_px) {
   const fs::path folder = fs::path(data_dir) / name;
   const std::string list_path = (folder / "images.txt").string();
   const std::vector<FrameInfo> list = ReadFrameList(list_path);
@@ -41,7 +43,14 @@ SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& 
   }
   SimulatedClip clip;
   for (int i = 0; i < kClipFrames; ++i) {
-    clip.frames.AppendFrame(ReadGreyImage((folder / list[i].path).string()), list[i].t_ns);
+    Image frame = ReadGreyImage((folder / list[i].path).string());
+    if (crop_px > 0) {
+      const int height = std::min<int>(crop_px, frame.rows());
+      const int width = std::min<int>(crop_px, frame.cols());
+      frame = Image(frame.block((frame.rows() - height) / 2, (frame.cols() - width) / 2, height,
+                                width));
+    }
+    clip.frames.AppendFrame(frame, list[i].t_ns);
   }
   clip.events = SimulateEvents(clip.frames, SimulatorOptions());
   return clip;

@@ -30,9 +30,11 @@ constexpr int kClipFirstFrame = 0;
 constexpr int kClipTruthFrame = 2;
 constexpr int kClipLastFrame = 4;
 
-/// Reads the first kClipFrames frames of `data_dir`/`name` (images.txt) and simulates their
-/// events. Throws InputError for a missing or malformed clip.
-SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& name);
+/// Reads the first kClipFrames frames of `data_dir`/`name` (images.txt), keeps their central
+/// crop_px × crop_px pixels when crop_px > 0 (all of a side shorter than that), and simulates
+/// their events. Throws InputError for a missing or malformed clip.
+SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& name,
+                                int crop_px = 0);
 
 /// Interpolation of frame kClipTruthFrame from the sharp frames kClipFirstFrame and
 /// kClipLastFrame with the events between them.

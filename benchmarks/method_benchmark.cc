@@ -14,7 +14,8 @@
 //
 //   method_benchmark --data=../shared/data --out=build/bench [--quick] [--cases=a,b]
 //                    [--methods=ceres_lm,adam,...] [--configs=default,per_voxel,...]
-//                    [--clips=nfs_basketball_7,...] [--cell_timeout_s=600]
+//                    [--config_cases=slider_predict,...] [--clips=nfs_basketball_7,...]
+//                    [--clip_crop_px=200] [--cell_timeout_s=600]
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <sched.h>
@@ -43,6 +44,7 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
+#include "examples/allocator_tuning.h"
 #include "examples/method.h"
 #include "examples/reconstruct_job.h"
 #include "solver/problem_builder.h"
@@ -57,16 +59,22 @@ DEFINE_string(cases,
 DEFINE_string(methods, "",
               "Comma-separated methods (ceres_lm, ceres_lbfgs, adam, adam_smooth, blend, copy, "
               "integrate, cf, edi); empty: all.");
-// No adobe240 clip by default (kClipsDefaultNote says why).
-DEFINE_string(clips, "nfs_basketball_7",
-              "Ground-truth clips for clip_interpolate and clip_deblur (nfs_basketball_7, "
-              "adobe240_GOPR9637b, adobe240_GOPR9642, adobe240_IMG_0004b, adobe240_IMG_0036).");
+DEFINE_string(clips,
+              "nfs_basketball_7,adobe240_GOPR9637b,adobe240_GOPR9642,adobe240_IMG_0004b,"
+              "adobe240_IMG_0036",
+              "Ground-truth clips for clip_interpolate and clip_deblur.");
+// kClipCropNote says why the clips are cropped by default.
+DEFINE_int32(clip_crop_px, 200,
+             "Keep the central N x N pixels of each clip (0: the whole frame).");
 DEFINE_bool(quick, false,
             "Only slider_predict and shapes_interpolate, every method but ceres_lbfgs (unless "
             "--methods names it) in its default configuration: no Ceres variants, no edi oracle.");
 DEFINE_string(configs, "default,sparse_cholesky,eta_0.01,per_voxel",
               "Comma-separated ceres_lm configurations: default (CGNR + Jacobi, eta 0.1, merged "
               "quiet steps), sparse_cholesky, eta_0.01, per_voxel.");
+DEFINE_string(config_cases, "slider_predict,shapes_interpolate",
+              "Cases that run every --configs variant; the others run ceres_lm in its default "
+              "configuration only.");
 DEFINE_int32(cell_timeout_s, 600, "A cell still running after this many seconds is stopped.");
 // A third of this 24 GB machine, which other work shares: a runaway cell (sparse Cholesky or the
 // per-voxel layout on a large scene) fails alone instead of starving the machine.
@@ -81,12 +89,12 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Why --clips leaves the adobe240 clips out by default.
-constexpr char kClipsDefaultNote[] =
-    "the four 500x500 adobe240 clips are left out by default: with the 12 M voxel budget one "
-    "adobe clip's interpolation took 45 s in ceres_lm and 110 s in adam on 2 cores, and the two "
-    "cases of one clip across the whole matrix would add well over half an hour; name them in "
-    "--clips to run them";
+// Why the clips are cropped by default.
+constexpr char kClipCropNote[] =
+    "the clips are cropped to their central 200x200 pixels (the size of nfs_basketball_7): at "
+    "500x500 with all 48 latent frames one adobe240 clip's interpolation takes about 45 s in "
+    "ceres_lm and 110 s in adam on 2 cores, and its two cases across the matrix well over half "
+    "an hour; --clip_crop_px=0 runs the whole frames";
 
 // ---------------------------------------------------------------------------------------------
 // Cases and configurations.
@@ -308,7 +316,7 @@ CellResult RunSnippetCell(const Case& c, const MethodOptions& options) {
 }
 
 CellResult RunClipCell(const Case& c, const MethodOptions& options, const std::string& config) {
-  const SimulatedClip clip = LoadSimulatedClip(FLAGS_data, c.data);
+  const SimulatedClip clip = LoadSimulatedClip(FLAGS_data, c.data, FLAGS_clip_crop_px);
   const bool deblur = c.mode == Mode::kDeblur;
   const Scene scene = deblur ? MakeClipDeblurScene(clip, BinningOptions())
                              : MakeClipInterpolationScene(clip, BinningOptions());
@@ -465,7 +473,8 @@ CellResult RunCellProcess(const Cell& cell, const std::string& result_path) {
   fs::remove(result_path);
   std::vector<std::string> args = {"/proc/self/exe",
                                    "--cell=" + cell.c.id + "," + cell.method + "," + cell.config,
-                                   "--cell_result=" + result_path, "--data=" + FLAGS_data};
+                                   "--cell_result=" + result_path, "--data=" + FLAGS_data,
+                                   "--clip_crop_px=" + std::to_string(FLAGS_clip_crop_px)};
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
@@ -505,6 +514,7 @@ CellResult RunCellProcess(const Cell& cell, const std::string& result_path) {
 struct Plan {
   std::vector<Method> methods;
   std::vector<std::string> ceres_configs;
+  std::vector<std::string> config_cases;  // the cases that run every ceres_configs variant
   bool edi_oracle = true;
 };
 
@@ -523,7 +533,11 @@ std::vector<Cell> PlanCells(const Case& c, const Plan& plan, std::vector<std::st
     };
     if (method != Method::kCeresLm) add(kDefaultConfig);
     if (method == Method::kCeresLm) {
-      for (const std::string& config : plan.ceres_configs) add(config);
+      const bool variants = std::find(plan.config_cases.begin(), plan.config_cases.end(),
+                                      c.id) != plan.config_cases.end();
+      for (const std::string& config : plan.ceres_configs) {
+        if (variants || config == kDefaultConfig) add(config);
+      }
     }
     // Only the clip deblur has both a blurred input and sharp truth frames.
     if (method == Method::kEdi && plan.edi_oracle && c.has_truth) add(kTunedConfig);
@@ -554,6 +568,7 @@ Plan SelectedPlan() {
   plan.edi_oracle = !FLAGS_quick;
   plan.ceres_configs =
       FLAGS_quick ? std::vector<std::string>{kDefaultConfig} : SplitCommaList(FLAGS_configs);
+  plan.config_cases = SplitCommaList(FLAGS_config_cases);
   for (const std::string& config : plan.ceres_configs) {
     CellOptions(Method::kCeresLm, config);  // throws for an unknown configuration
   }
@@ -844,9 +859,12 @@ std::string Markdown(const std::vector<CaseReport>& reports, const std::string& 
   md += "Command: `method_benchmark --data=" + FLAGS_data + " --out=" + FLAGS_out +
         (FLAGS_quick ? " --quick" : "") +
         (FLAGS_methods.empty() ? "" : " --methods=" + FLAGS_methods) +
-        (FLAGS_quick ? "" : " --configs=" + FLAGS_configs) + "`; cases: " + cases;
+        " --clip_crop_px=" + std::to_string(FLAGS_clip_crop_px) +
+        (FLAGS_quick ? "" : " --configs=" + FLAGS_configs + " --config_cases=" + FLAGS_config_cases) +
+        "`; cases: " + cases;
   if (cases.find("clip_") != std::string::npos) {
-    md += "; clips: " + FLAGS_clips + " (" + kClipsDefaultNote + ")";
+    md += "; clips: " + FLAGS_clips + " (" +
+          (FLAGS_clip_crop_px > 0 ? std::string(kClipCropNote) : "whole frames") + ")";
   }
   md += ".\n\n";
   md +=
@@ -952,6 +970,7 @@ int RunParent() {
 }  // namespace evfs
 
 int main(int argc, char** argv) {
+  evfs::KeepFreedMemoryForReuse();
   gflags::SetUsageMessage("every reconstruction method on every case of the shared data");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);

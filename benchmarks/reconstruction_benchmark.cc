@@ -20,6 +20,7 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
+#include "examples/allocator_tuning.h"
 #include "examples/reconstruct_job.h"
 #include "solver/reconstructor.h"
 
@@ -219,6 +220,7 @@ int Main() {
 }  // namespace evfs
 
 int main(int argc, char** argv) {
+  evfs::KeepFreedMemoryForReuse();
   gflags::SetUsageMessage("reconstruction quality and time on the shared data, default options");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);

@@ -23,6 +23,7 @@
 #include "core/time.h"
 #include "events/binning.h"
 #include "events/simulator.h"
+#include "examples/allocator_tuning.h"
 #include "examples/demo.h"
 #include "examples/reconstruct_job.h"
 #include "io/data_source.h"
@@ -367,6 +368,7 @@ int RunCommand(const std::string& command) {
 }  // namespace evfs
 
 int main(int argc, char** argv) {
+  evfs::KeepFreedMemoryForReuse();
   gflags::SetUsageMessage(evfs::kUsage);
   gflags::SetVersionString("0.1.0");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
