@@ -32,6 +32,8 @@ constexpr char kTsUnit[] = "ts_unit";
 // Image dataset names appear in error messages, which must stay one short line; tools write
 // names like image000000000.
 constexpr size_t kMaxImageNameBytes = 64;
+// Event coordinates are uint16, so no sensor side is longer.
+constexpr hsize_t kMaxImageSide = 65536;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
 
@@ -282,7 +284,9 @@ class Hdf5DataSource::File {
                                      "cannot open " + name);
     const std::vector<hsize_t> dims = Dimensions(h5_, dataset.get(), name);
     if (dims.size() != 2) h5_.Fail(InputError::Kind::kMalformed, name + " must be a 2-D image");
-    if (static_cast<int>(dims[0]) != height_ || static_cast<int>(dims[1]) != width_) {
+    // Compared as hsize_t: a cast to int would wrap a corrupt extent of 2^32 + height rows onto
+    // the sensor's height and let H5Dread write past the image.
+    if (dims[0] != static_cast<hsize_t>(height_) || dims[1] != static_cast<hsize_t>(width_)) {
       h5_.Fail(InputError::Kind::kSizeMismatch,
                name + " is " + std::to_string(dims[1]) + "x" + std::to_string(dims[0]) +
                    ", the sensor is " + std::to_string(width_) + "x" + std::to_string(height_));
@@ -456,6 +460,11 @@ class Hdf5DataSource::File {
       if (dims.size() != 2) h5_.Fail(InputError::Kind::kMalformed, full + " must be a 2-D image");
       CheckStored(h5_, dataset.get(), full, dims);
       if (width_ == 0 || height_ == 0) {
+        if (dims[0] < 1 || dims[1] < 1 || dims[0] > kMaxImageSide || dims[1] > kMaxImageSide) {
+          h5_.Fail(InputError::Kind::kMalformed,
+                   full + " is " + std::to_string(dims[1]) + "x" + std::to_string(dims[0]) +
+                       ": each side must be 1 to " + std::to_string(kMaxImageSide) + " pixels");
+        }
         height_ = static_cast<int>(dims[0]);
         width_ = static_cast<int>(dims[1]);
       }

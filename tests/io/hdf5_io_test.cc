@@ -350,6 +350,58 @@ TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {
                             "images/image000000001", 0);
 }
 
+// A compressed dataset may declare any extent (its stored size says nothing about it). One of
+// 2^32 + 48 rows once passed as the 48-row sensor's image (the extent was cast to int) and
+// H5Dread wrote past the image: it must be an error, whether it is the first image (which sets
+// the sensor size) or a later one.
+TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
+  const std::string dir = testing::ScratchDir("h5_huge_extent");
+  const Recording recording = MakeRecording(7, 10);
+  const auto with_huge_image = [&](const std::string& file_name, const std::string& name) {
+    const std::string path = dir + "/" + file_name;
+    WriteHdf5(path, recording.events, recording.frames, recording.images);
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    EXPECT_GE(H5Ldelete(file, name.c_str(), H5P_DEFAULT), 0);
+    const hsize_t dims[2] = {(hsize_t{1} << 32) + kHeight, kWidth};
+    const hsize_t chunk[2] = {kHeight, kWidth};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t properties = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(properties, 2, chunk);
+    H5Pset_deflate(properties, 1);
+    const hid_t dataset =
+        H5Dcreate2(file, name.c_str(), H5T_STD_U8LE, space, H5P_DEFAULT, properties, H5P_DEFAULT);
+    const hsize_t origin[2] = {0, 0};
+    H5Sselect_hyperslab(space, H5S_SELECT_SET, origin, nullptr, chunk, nullptr);
+    const hid_t memory = H5Screate_simple(2, chunk, nullptr);
+    const std::vector<uint8_t> zeros(kHeight * kWidth, 0);
+    H5Dwrite(dataset, H5T_NATIVE_UINT8, memory, space, H5P_DEFAULT, zeros.data());
+    const double timestamp = name.back() == '0' ? 2.0 : 3.0;
+    WriteScalarAttribute(dataset, "timestamp", H5T_NATIVE_DOUBLE, &timestamp);
+    H5Sclose(memory);
+    H5Dclose(dataset);
+    H5Pclose(properties);
+    H5Sclose(space);
+    H5Fclose(file);
+    return path;
+  };
+  // With the sensor size in the file, the first image is checked against it when read.
+  const Hdf5DataSource first(with_huge_image("first.h5", "images/image000000000"));
+  testing::ExpectInputError([&] { first.ReadImage(0); }, InputError::Kind::kSizeMismatch,
+                            "images/image000000000 is 64x4294967344", 0);
+  // Without, the first image sets it.
+  const std::string unsized = with_huge_image("unsized.h5", "images/image000000000");
+  const hid_t file = H5Fopen(unsized.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  EXPECT_GE(H5Adelete(file, "sensor_resolution"), 0);
+  H5Fclose(file);
+  testing::ExpectInputError([&] { Hdf5DataSource source(unsized); },
+                            InputError::Kind::kMalformed, "each side must be 1 to 65536 pixels",
+                            0);
+  const Hdf5DataSource later(with_huge_image("later.h5", "images/image000000001"));
+  EXPECT_NO_THROW(later.ReadImage(0));
+  testing::ExpectInputError([&] { later.ReadImage(1); }, InputError::Kind::kSizeMismatch,
+                            "images/image000000001 is 64x4294967344", 0);
+}
+
 TEST(Hdf5IoTest, UnwritablePathIsAnInputError) {
   const std::string path = testing::ScratchDir("h5_unwritable") + "/no/folder/out.h5";
   testing::ExpectInputError([&] { WriteHdf5(path, EventStream(), {}, {}); },
