@@ -16,6 +16,7 @@ function(evfs_add_test name)
   add_executable(${name} ${ARG_SRCS})
   target_link_libraries(${name} PRIVATE ${ARG_LINK_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE EVFS_DATA_DIR="${EVFS_DATA_DIR}"
+                             EVFS_TEST_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
                              EVFS_TEST_TMP_DIR="${CMAKE_CURRENT_BINARY_DIR}/tmp_${name}")
   add_test(NAME ${name} COMMAND ${name})
 endfunction()

@@ -162,8 +162,10 @@ void CheckStored(const H5Context& h5, hid_t dataset, const std::string& name,
   const Handle type = h5.Check(H5Dget_type(dataset), H5Tclose, "unreadable type of " + name);
   const Handle properties =
       h5.Check(H5Dget_create_plist(dataset), H5Pclose, "unreadable properties of " + name);
+  const size_t value_bytes = H5Tget_size(type.get());
+  if (value_bytes == 0) h5.Fail(InputError::Kind::kMalformed, "unreadable type of " + name);
   // In long double: a corrupt extent can overflow 64 bits.
-  long double declared_bytes = static_cast<long double>(H5Tget_size(type.get()));
+  long double declared_bytes = static_cast<long double>(value_bytes);
   for (const hsize_t dim : dims) declared_bytes *= static_cast<long double>(dim);
   if (declared_bytes == 0) return;
   const hsize_t stored_bytes = H5Dget_storage_size(dataset);

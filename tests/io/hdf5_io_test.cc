@@ -402,6 +402,15 @@ TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
                             "images/image000000001 is 64x4294967344", 0);
 }
 
+// The file the HDF5 fuzzer found it with: a contiguous image whose type reads as 0 bytes (so no
+// stored size could be checked) and whose extent wraps onto 12x16 in 32 bits.
+TEST(Hdf5IoTest, FuzzerFindingImageExtentWrapsIntIsAnInputError) {
+  const std::string path =
+      std::string(EVFS_TEST_SOURCE_DIR) + "/data/fuzz_image_extent_wraps_int.h5";
+  testing::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kMalformed,
+                            "unreadable type of images/image000000001", 0);
+}
+
 TEST(Hdf5IoTest, UnwritablePathIsAnInputError) {
   const std::string path = testing::ScratchDir("h5_unwritable") + "/no/folder/out.h5";
   testing::ExpectInputError([&] { WriteHdf5(path, EventStream(), {}, {}); },
