@@ -14,7 +14,9 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gflags/gflags.h>
 #include <glog/logging.h>
@@ -96,6 +98,9 @@ DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps, 
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "Solve the regions that no term couples as separate problems, concurrently "
             "(one after another with --progress or --checkpoints); false: one problem.");
+DEFINE_string(smoothing_continuation, "",
+              "Comma-separated smoothing scales solved first, each starting the next, before "
+              "--smoothing_scale (e.g. 0.2,0.1); empty: one solve.");
 // Ceres.
 DEFINE_string(linear_solver, "CGNR", "Ceres linear solver: CGNR | SPARSE_NORMAL_CHOLESKY | "
               "ITERATIVE_SCHUR | DENSE_QR ...");
@@ -234,6 +239,27 @@ int RunSimulate() {
 }
 
 // One progress line per iteration of an iterative solver.
+// "0.2,0.1" → {0.2, 0.1}; "" → {}. Throws InvalidArgumentError naming `flag` for a non-number.
+std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
+  std::vector<double> numbers;
+  std::stringstream stream(list);
+  for (std::string item; std::getline(stream, item, ',');) {
+    size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) {
+      throw InvalidArgumentError(std::string(flag) + " must be comma-separated numbers, not '" +
+                                 item + "'");
+    }
+    numbers.push_back(value);
+  }
+  return numbers;
+}
+
 bool PrintProgress(const SolverIteration& iteration) {
   std::fprintf(stderr, "iter %4d  cost %.6e  %.2f s\n", iteration.iteration, iteration.cost,
                iteration.elapsed_s);
@@ -293,6 +319,8 @@ ReconstructRequest RequestFromFlags() {
   options.activity_radius_px = FLAGS_activity_radius_px;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
   options.split_independent_parts = FLAGS_split_independent_parts;
+  options.smoothing_continuation =
+      ParseNumberList(FLAGS_smoothing_continuation, "--smoothing_continuation");
 
   ceres::Solver::Options& solver = options.solver;
   Require(ceres::StringToLinearSolverType(FLAGS_linear_solver, &solver.linear_solver_type),

@@ -49,6 +49,8 @@ class JsonWriter {
   void Field(const std::string& key, int value) { Key(key).Raw(std::to_string(value)); }
   void Field(const std::string& key, int64_t value) { Key(key).Raw(std::to_string(value)); }
   void Field(const std::string& key, double value) { Key(key).Number(value); }
+  /// A number as the next element of the open array.
+  void Element(double value) { Number(value); }
 
   const std::string& str() const { return text_; }
 

@@ -263,6 +263,9 @@ void WriteProblem(const ReconstructionOptions& options, const ProblemStatistics&
   json->Key("problem").BeginObject();
   json->Field("independent_parts", problem.parts);
   json->Field("split_independent_parts", options.split_independent_parts);
+  json->Key("smoothing_continuation").BeginArray();
+  for (const double scale : options.smoothing_continuation) json->Element(scale);
+  json->EndArray();
   json->Field("parameter_blocks", problem.parameter_blocks);
   json->Field("unknowns", problem.variable_parameter_blocks);
   json->Field("residual_blocks", problem.residual_blocks());

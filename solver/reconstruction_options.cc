@@ -101,6 +101,12 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
              "off or use the trust-region minimiser";
     return false;
   }
+  for (const double scale : smoothing_continuation) {
+    if (!(scale > 0.0) || !std::isfinite(scale)) {
+      *error = "every smoothing_continuation scale must be positive and finite";
+      return false;
+    }
+  }
   if (min_part_pixels < 1) {
     *error = "min_part_pixels must be at least 1";
     return false;

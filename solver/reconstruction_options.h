@@ -4,6 +4,7 @@
 #define EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
 
 #include <string>
+#include <vector>
 
 #include <ceres/ceres.h>
 
@@ -73,6 +74,11 @@ struct ReconstructionOptions {
   /// threads share the work. With an iteration callback the parts are solved one after another
   /// (the callback sees the whole latent video). False: one problem.
   bool split_independent_parts = true;
+  /// Continuation on the smoothing scale: solve with each of these ε in turn (e.g. {0.2, 0.1}),
+  /// each solution starting the next, before the objective's own. Empty (the default): one
+  /// solve. The summary reports the last solve's costs and the iterations and times of all.
+  std::vector<double> smoothing_continuation;
+
   /// Independent regions smaller than this (pixels) are packed into one part: a Ceres solve has
   /// a fixed cost of about a millisecond.
   int64_t min_part_pixels = 1024;

@@ -119,38 +119,22 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
   return objective;
 }
 
-Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
-                           const Video* initial, const IterationCallback& callback) {
-  std::string error;
-  if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
-  Reconstruction result;
-  ReconstructionOptions solve_options = options;
-  solve_options.objective =
-      ResolveObjective(scene, options, &result.summary.model, &result.summary.alpha_derived);
-
-  if (initial != nullptr) {
-    if (initial->num_frames() != scene.num_latent_frames() || initial->height() != scene.height ||
-        initial->width() != scene.width) {
-      throw InvalidArgumentError("the initial video does not match the scene's latent timeline");
-    }
-    result.video = *initial;
-  } else {
-    result.video = InitializeLatentVideo(scene);
-  }
-  ReconstructionSummary& summary = result.summary;
-  if (scene.num_events == 0) {
-    summary.skipped_reason = "no events in the window: the initialisation is the answer";
-    return result;
-  }
-
+// One Levenberg–Marquardt solve of `solve_options`' objective from result->video, which it
+// updates; adds its counts and times to result->summary.
+void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_options,
+                   const IterationCallback& callback, Reconstruction* result) {
+  ReconstructionSummary& summary = result->summary;
+  const double build_time_before = summary.build_time_s, solve_time_before = summary.solve_time_s;
+  const int iterations_before = summary.iterations;
+  summary.iterations = 0;
   const int threads = std::max(1, solve_options.solver.num_threads);
   const auto build_start = Clock::now();
   const ProblemBuilder builder(scene, solve_options);
   std::vector<std::unique_ptr<BuiltProblem>> parts;
-  if (options.split_independent_parts) {
-    parts = builder.BuildParts(&result.video, threads);
+  if (solve_options.split_independent_parts) {
+    parts = builder.BuildParts(&result->video, threads);
   } else {
-    parts.push_back(builder.Build(&result.video));
+    parts.push_back(builder.Build(&result->video));
   }
   summary.build_time_s = SecondsSince(build_start);
   summary.problem = ProblemStatistics();
@@ -160,7 +144,7 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
                                    summary.problem.active_pixels;
   if (summary.problem.variable_parameter_blocks == 0) {
     summary.skipped_reason = "no unknowns: no pixel is active";
-    return result;
+    return;
   }
 
   std::vector<ceres::Solver::Summary> part_summaries(parts.size());
@@ -186,7 +170,7 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   double time_in_callback_s = 0.0;
   if (callback) {
     // One after another, each with every thread, so that the callback sees a whole video.
-    CallbackAdapter adapter(callback, parts.front()->layout(), &result.video);
+    CallbackAdapter adapter(callback, parts.front()->layout(), &result->video);
     for (size_t i = 0; i < parts.size() && !adapter.stopped(); ++i) {
       double others = 0.0;
       for (size_t j = 0; j < parts.size(); ++j) others += j == i ? 0.0 : costs[j];
@@ -225,7 +209,45 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
-  parts.front()->layout().Expand(&result.video);
+  parts.front()->layout().Expand(&result->video);
+  summary.build_time_s += build_time_before;
+  summary.solve_time_s += solve_time_before;
+  summary.iterations += iterations_before;
+}
+
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
+                           const Video* initial, const IterationCallback& callback) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
+  Reconstruction result;
+  ReconstructionOptions solve_options = options;
+  solve_options.objective =
+      ResolveObjective(scene, options, &result.summary.model, &result.summary.alpha_derived);
+
+  if (initial != nullptr) {
+    if (initial->num_frames() != scene.num_latent_frames() || initial->height() != scene.height ||
+        initial->width() != scene.width) {
+      throw InvalidArgumentError("the initial video does not match the scene's latent timeline");
+    }
+    result.video = *initial;
+  } else {
+    result.video = InitializeLatentVideo(scene);
+  }
+  ReconstructionSummary& summary = result.summary;
+  if (scene.num_events == 0) {
+    summary.skipped_reason = "no events in the window: the initialisation is the answer";
+    return result;
+  }
+
+  // Continuation: each smoothing scale's solution starts the next, the objective's own last.
+  std::vector<double> scales = options.smoothing_continuation;
+  scales.push_back(solve_options.objective.smoothing_scale);
+  for (const double scale : scales) {
+    ReconstructionOptions stage = solve_options;
+    stage.objective.smoothing_scale = scale;
+    BuildAndSolve(scene, stage, callback, &result);
+    if (!summary.solved) break;  // nothing to solve
+  }
   return result;
 }
 

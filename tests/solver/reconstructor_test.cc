@@ -85,6 +85,27 @@ TEST(Reconstructor, WindowWithoutEventsIsAnsweredWithoutSolving) {
   EXPECT_EQ(result.video.num_frames(), 2);
 }
 
+TEST(Reconstructor, ContinuationOnTheSmoothingScaleEndsOnTheObjectivesOwn) {
+  const testing::SyntheticRecording recording;
+  const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                             recording.events, BinningOptions());
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  const Reconstruction plain = Reconstruct(scene, options);
+  options.smoothing_continuation = {0.3, 0.1};
+  const Reconstruction continued = Reconstruct(scene, options);
+  ASSERT_TRUE(continued.summary.solved);
+  // Three solves: more iterations in all, and the last one's cost is the objective's own.
+  EXPECT_GT(continued.summary.iterations, plain.summary.iterations);
+  EXPECT_NEAR(continued.summary.final_cost, plain.summary.final_cost,
+              0.05 * plain.summary.final_cost);
+  EXPECT_NEAR(PsnrAt(continued.video, recording, 10), PsnrAt(plain.video, recording, 10), 1.0);
+  options.smoothing_continuation = {0.3, 0.0};
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("smoothing_continuation"), std::string::npos) << error;
+}
+
 // Two shapes far apart on a wide sensor: two independent regions, each its own part.
 Scene TwoRegionScene(const testing::SyntheticRecording& recording) {
   return MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20), recording.events,
