@@ -85,7 +85,7 @@ ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) 
 // What every part of a scene shares: which pixels are solved for and how their time series are
 // cut into segments.
 struct ProblemBuilder::Prepared {
-  std::unique_ptr<ActivityMask> mask;
+  ActivityMask mask;
   std::shared_ptr<const LatentLayout> layout;
 };
 
@@ -97,10 +97,9 @@ ProblemBuilder::Prepared ProblemBuilder::Prepare(Video* latent) const {
       latent->width() != scene_.width) {
     throw InvalidArgumentError("the latent video does not match the scene's size");
   }
-  Prepared prepared;
-  prepared.mask = std::make_unique<ActivityMask>(scene_.events, options_.activity_radius_px);
+  Prepared prepared{ActivityMask(scene_.events, options_.activity_radius_px), nullptr};
   auto layout =
-      std::make_shared<LatentLayout>(scene_, *prepared.mask, *latent, options_.merge_quiet_steps);
+      std::make_shared<LatentLayout>(scene_, prepared.mask, *latent, options_.merge_quiet_steps);
   layout->ProjectOnto(latent);
   prepared.layout = std::move(layout);
   return prepared;
@@ -109,11 +108,11 @@ ProblemBuilder::Prepared ProblemBuilder::Prepare(Video* latent) const {
 std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   const Prepared prepared = Prepare(latent);
   std::vector<int64_t> pixels;
-  for (int64_t p = 0; p < prepared.mask->num_pixels(); ++p) {
-    if (prepared.mask->in_problem(p)) pixels.push_back(p);
+  for (int64_t p = 0; p < prepared.mask.num_pixels(); ++p) {
+    if (prepared.mask.in_problem(p)) pixels.push_back(p);
   }
   std::unique_ptr<BuiltProblem> built = BuildPart(prepared, pixels, latent);
-  built->statistics_.skipped_pixels = prepared.mask->num_pixels() - prepared.mask->num_active();
+  built->statistics_.skipped_pixels = prepared.mask.num_pixels() - prepared.mask.num_active();
   return built;
 }
 
@@ -121,7 +120,7 @@ std::vector<std::unique_ptr<BuiltProblem>> ProblemBuilder::BuildParts(Video* lat
                                                                       int build_workers) const {
   const Prepared prepared = Prepare(latent);
   const std::vector<std::vector<int64_t>> parts =
-      prepared.mask->IndependentParts(options_.min_part_pixels);
+      prepared.mask.IndependentParts(options_.min_part_pixels);
   std::vector<std::unique_ptr<BuiltProblem>> built(parts.size());
   ParallelForEach(static_cast<int>(parts.size()), build_workers,
                   [&](int i) { built[i] = BuildPart(prepared, parts[i], latent); });
@@ -132,7 +131,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
                                                         const std::vector<int64_t>& pixels,
                                                         Video* latent) const {
   const ObjectiveOptions& objective = options_.objective;
-  const ActivityMask& mask = *prepared.mask;
+  const ActivityMask& mask = prepared.mask;
   const LatentLayout& layout = *prepared.layout;
   const int num_latent = scene_.num_latent_frames();
   const int width = scene_.width, height = scene_.height;

@@ -85,8 +85,9 @@ struct ReconstructionOptions {
   /// solve. The summary reports the last solve's costs and the iterations and times of all.
   std::vector<double> smoothing_continuation;
 
-  /// Independent regions smaller than this (pixels) are packed into one part: a Ceres solve has
-  /// a fixed cost of about a millisecond.
+  /// Independent regions smaller than this (pixels) are packed into one part: each Ceres solve
+  /// has a fixed cost (preprocessing, allocation, its summary), which scattered noise events
+  /// would otherwise pay thousands of times.
   int64_t min_part_pixels = 1024;
 
   /// Ceres settings, all of them available to library users; the defaults below are set by

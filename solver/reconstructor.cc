@@ -120,13 +120,10 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
 }
 
 // One Levenberg–Marquardt solve of `solve_options`' objective from result->video, which it
-// updates; adds its counts and times to result->summary.
+// updates; adds its times and iterations to result->summary and sets the rest from this solve.
 void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_options,
                    const IterationCallback& callback, Reconstruction* result) {
   ReconstructionSummary& summary = result->summary;
-  const double build_time_before = summary.build_time_s, solve_time_before = summary.solve_time_s;
-  const int iterations_before = summary.iterations;
-  summary.iterations = 0;
   const int threads = std::max(1, solve_options.solver.num_threads);
   const auto build_start = Clock::now();
   const ProblemBuilder builder(scene, solve_options);
@@ -136,7 +133,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   } else {
     parts.push_back(builder.Build(&result->video));
   }
-  summary.build_time_s = SecondsSince(build_start);
+  summary.build_time_s += SecondsSince(build_start);
   summary.problem = ProblemStatistics();
   summary.problem.parts = 0;
   for (const auto& part : parts) summary.problem += part->statistics();
@@ -171,14 +168,14 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   if (callback) {
     // One after another, each with every thread, so that the callback sees a whole video.
     CallbackAdapter adapter(callback, parts.front()->layout(), &result->video);
+    double current_total = total_cost;  // the parts done at their final cost, the rest initial
     for (size_t i = 0; i < parts.size() && !adapter.stopped(); ++i) {
-      double others = 0.0;
-      for (size_t j = 0; j < parts.size(); ++j) others += j == i ? 0.0 : costs[j];
-      adapter.StartPart(others, i == 0);
+      adapter.StartPart(current_total - costs[i], i == 0);
       ceres::Solver::Options options_i = part_options(i, threads);
       options_i.callbacks.push_back(&adapter);
       options_i.update_state_every_iteration = true;
       ceres::Solve(options_i, &parts[i]->problem(), &part_summaries[i]);
+      current_total += part_summaries[i].final_cost - costs[i];
       costs[i] = part_summaries[i].final_cost;
     }
     time_in_callback_s = adapter.time_in_callback_s();
@@ -197,12 +194,14 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
                    &part_summaries[i]);
     });
   }
-  summary.solve_time_s = SecondsSince(solve_start) - time_in_callback_s;
+  summary.solve_time_s += SecondsSince(solve_start) - time_in_callback_s;
+  int iterations = 0;  // of the part that took most
   for (size_t i = 0; i < parts.size(); ++i) {
     Accumulate(part_summaries[i], i == 0, &summary.ceres);
-    summary.iterations = std::max(
-        summary.iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
+    iterations =
+        std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
   }
+  summary.iterations += iterations;
   if (summary.ceres.termination_type == ceres::FAILURE) {
     throw InvalidArgumentError("the solve failed: " + summary.ceres.message);
   }
@@ -210,9 +209,6 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
   parts.front()->layout().Expand(&result->video);
-  summary.build_time_s += build_time_before;
-  summary.solve_time_s += solve_time_before;
-  summary.iterations += iterations_before;
 }
 
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
