@@ -81,8 +81,9 @@ DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight, "la
 DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight, "lambda_t: weight of temporal total variation.");
 DEFINE_double(alpha, 0.0, "alpha of tanh(alpha * dg); 0 derives it from the data's contrast "
               "threshold (printed).");
-DEFINE_string(event_model, "linear", "linear (g(x) = x, paper Eq. 2) | log (g(x) = log(x + b)).");
-DEFINE_double(log_offset, evfs::EventModelParams().log_offset, "b of the log event model.");
+DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_model.model),
+              "log (g(x) = log(x + b), paper Eq. 1) | linear (g(x) = x, paper Eq. 2).");
+DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset, "b of the log event model.");
 DEFINE_string(spatial_tv, "anisotropic", "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | "
               "isotropic (sqrt(dx^2+dy^2)).");
 DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale, "epsilon of the smoothed l1: sqrt(eps^2 + r^2) - eps.");

@@ -79,22 +79,22 @@ const Term kTerms[] = {
     {"temporal_tv", &ObjectiveOptions::temporal_tv_weight},
 };
 
-// The PSNR property of a weight setting. Without the frame term, or with another term at ten or
-// more times its default weight, nothing holds the minimiser of the objective near the truth
-// any more: the frames are what tie H to the observed intensities, and a term that outweighs
-// them pulls H towards its own optimum (events integrated from nowhere, a flat image, a video
-// frozen in time). What the solver returns is then the model's answer, not an instability, and
-// it may lose anything: measured on this scene, −1.5 dB without frames, −2.2 and −5.4 dB at
-// event weights 10 and 100, −0.8 and −1.3 dB at spatial and temporal TV weights 100, where the
-// flat mean grey image loses −5.7 dB. The result must still cost no more than the truth
-// (kTruthNotTheOptimum): it cost 25 % to 97 % less.
+// The PSNR property of a weight setting. With the frame term at a tenth or less of its default
+// weight, or another term at ten or more times its default, nothing holds the minimiser of the
+// objective near the truth any more: the frames are what tie H to the observed intensities,
+// and a term that outweighs them pulls H towards its own optimum (events integrated from
+// nowhere, a flat image, a video frozen in time). What the solver returns is then the model's
+// answer, not an instability, and it may lose anything: measured on this scene (log model),
+// −12 and −3.2 dB at frame weights 0 and 0.1, −3.1 and −5.6 dB at event weights 10 and 100,
+// −1.3 dB at spatial TV weight 100 and −1.4 dB at temporal TV weight 100. The result must still
+// cost no more than the truth (kTruthNotTheOptimum): it cost 29 % to 98 % less.
 PsnrCheck WeightPsnrCheck(const Term& term, double weight) {
   const ObjectiveOptions defaults;
   const bool is_frame = term.weight == &ObjectiveOptions::frame_weight;
-  const bool frames_dropped = is_frame && weight == 0.0;
+  const bool frames_weakened = is_frame && weight <= defaults.frame_weight / 10.0;
   const bool frames_outweighed = !is_frame && weight >= 10.0 * defaults.*term.weight;
-  return frames_dropped || frames_outweighed ? PsnrCheck::kTruthNotTheOptimum
-                                             : PsnrCheck::kWithinMargin;
+  return frames_weakened || frames_outweighed ? PsnrCheck::kTruthNotTheOptimum
+                                              : PsnrCheck::kWithinMargin;
 }
 
 class WeightSweep : public ::testing::TestWithParam<std::tuple<Term, double>> {};
