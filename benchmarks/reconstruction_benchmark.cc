@@ -33,6 +33,8 @@ DEFINE_string(clips,
 DEFINE_string(csv, "", "Also write the rows as CSV to this file.");
 // Overrides of the defaults, for exploring them; the published figures use none.
 DEFINE_double(alpha, evfs::ObjectiveOptions().event_model.alpha, "alpha; 0 derives it.");
+DEFINE_double(alpha_times_change, evfs::EventModelEstimationOptions().alpha_times_change,
+              "derived alpha times the change of g one event stands for.");
 DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_model.model),
               "log | linear: the event model's intensity transform g.");
 DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset, "b of the log event model.");
@@ -74,6 +76,7 @@ ReconstructionOptions Options() {
   ReconstructionOptions options;
   options.objective.event_model.alpha = FLAGS_alpha;
   options.objective.event_model.log_offset = FLAGS_log_offset;
+  options.estimation.alpha_times_change = FLAGS_alpha_times_change;
   if (!ParseEventModel(FLAGS_event_model, &options.objective.event_model.model)) {
     throw InvalidArgumentError("--event_model: linear or log, got '" + FLAGS_event_model + "'");
   }
