@@ -49,6 +49,8 @@ DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_indepen
             "solve uncoupled regions as separate concurrent problems (false: one problem).");
 DEFINE_string(init, "blend", "blend | events: where the solve starts.");
 DEFINE_int32(clip_crop_px, 0, "Keep the central N x N pixels of each clip (0: whole frames).");
+DEFINE_int32(max_iterations, evfs::ReconstructionOptions().solver.max_num_iterations,
+             "most Levenberg-Marquardt iterations.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "auto binning's voxel budget.");
 
@@ -78,6 +80,7 @@ ReconstructionOptions Options() {
   options.objective.event_model.alpha = FLAGS_alpha;
   options.objective.event_model.log_offset = FLAGS_log_offset;
   options.estimation.alpha_times_change = FLAGS_alpha_times_change;
+  options.solver.max_num_iterations = FLAGS_max_iterations;
   if (!ParseEventModel(FLAGS_event_model, &options.objective.event_model.model)) {
     throw InvalidArgumentError("--event_model: linear or log, got '" + FLAGS_event_model + "'");
   }
