@@ -41,8 +41,8 @@ struct ObjectiveOptions {
   double temporal_tv_weight = 0.85;
   /// g and α of the event model: by default the log model g(x) = log(x + 0.5) with α derived
   /// from the data (α <= 0, EstimateEventModel). b = 0.5 by measurement (README sweep): the
-  /// log model fits the log-intensity events of the simulated clips (interpolation +0.5 to
-  /// +2.4 dB over the linear model) and b = 0.5 keeps slider_depth prediction, where the DAVIS
+  /// log model fits the log-intensity events of the simulated clips (interpolation +0.2 to
+  /// +1.8 dB over the linear model) and b = 0.5 keeps slider_depth prediction, where the DAVIS
   /// frames' response makes the linear model fit best, above 25 dB (b 0.1: 23.98 dB, 0.3:
   /// 24.93, 1.0: 24.90).
   EventModelParams event_model = DefaultEventModel();
