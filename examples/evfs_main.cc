@@ -239,7 +239,6 @@ int RunSimulate() {
   return 0;
 }
 
-// One progress line per iteration of an iterative solver.
 // "0.2,0.1" → {0.2, 0.1}; "" → {}. Throws InvalidArgumentError naming `flag` for a non-number.
 std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
   std::vector<double> numbers;
@@ -261,6 +260,7 @@ std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
   return numbers;
 }
 
+// One progress line per iteration of an iterative solver.
 bool PrintProgress(const SolverIteration& iteration) {
   std::fprintf(stderr, "iter %4d  cost %.6e  %.2f s\n", iteration.iteration, iteration.cost,
                iteration.elapsed_s);
