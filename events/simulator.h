@@ -67,6 +67,9 @@ class EventSimulator {
 
   int height() const { return height_; }
   int width() const { return width_; }
+  /// The per-pixel thresholds C_pos and C_neg (row-major), fixed in the constructor.
+  const std::vector<double>& threshold_pos() const { return threshold_pos_; }
+  const std::vector<double>& threshold_neg() const { return threshold_neg_; }
 
  private:
   /// One event before sorting and the refractory filter.

@@ -11,6 +11,7 @@
 // flag) prints one line and exits with status 2.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -191,8 +192,18 @@ int RunInfo() {
     const int64_t begin_ns = frames[FLAGS_first].t_ns, end_ns = frames[last].t_ns;
     const EventStream window = source->ReadEvents(begin_ns, end_ns);
     const EventFrames collision = BinByCollision(window, begin_ns, end_ns);
-    std::printf("window      frames %d..%d, %.6f s: %zu events, %d collision frames\n",
+    size_t positive = 0;
+    std::vector<bool> fired(static_cast<size_t>(source->width()) * source->height(), false);
+    for (size_t i = 0; i < window.size(); ++i) {
+      positive += window.polarity(i) > 0;
+      fired[static_cast<size_t>(window.y(i)) * source->width() + window.x(i)] = true;
+    }
+    const auto pixels_fired = std::count(fired.begin(), fired.end(), true);
+    std::printf("window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %td pixels "
+                "(%.1f %%), %d collision frames\n",
                 FLAGS_first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(),
+                positive, window.size() - positive, pixels_fired,
+                100.0 * static_cast<double>(pixels_fired) / static_cast<double>(fired.size()),
                 collision.num_frames());
   }
   return 0;

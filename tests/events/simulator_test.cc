@@ -189,6 +189,32 @@ TEST(EventSimulator, ThresholdMismatchSpreadsPerPixelCounts) {
   EXPECT_GT(count_range(SimulatorOptions()), 0);
 }
 
+TEST(EventSimulator, ExposesThePerPixelThresholdsItFiresAt) {
+  // A simulator built with the same options draws the same thresholds as SimulateEvents' own,
+  // and integrating the events with each pixel's thresholds lands within one of them.
+  const Video video = SmallSceneVideo(0.05);
+  const SimulatorOptions options;  // with threshold mismatch
+  const EventStream events = SimulateEvents(video, options);
+  const EventSimulator simulator(video.height(), video.width(), options);
+  const std::vector<double>& on = simulator.threshold_pos();
+  const std::vector<double>& off = simulator.threshold_neg();
+  ASSERT_EQ(on.size(), static_cast<size_t>(video.height() * video.width()));
+  ASSERT_EQ(off.size(), on.size());
+  EXPECT_NE(*std::min_element(on.begin(), on.end()), *std::max_element(on.begin(), on.end()));
+
+  Image integrated = (video.frame(0).array() + options.log_eps).log();
+  for (size_t i = 0; i < events.size(); ++i) {
+    const size_t p = static_cast<size_t>(events.y(i)) * video.width() + events.x(i);
+    integrated(events.y(i), events.x(i)) += events.polarity(i) > 0 ? on[p] : -off[p];
+  }
+  const Image last = (video.frame(video.num_frames() - 1).array() + options.log_eps).log();
+  const Image residual = last - integrated;
+  for (Eigen::Index p = 0; p < residual.size(); ++p) {
+    ASSERT_LT(residual.data()[p], on[p] + kRoundTripRoundingTolerance) << "pixel " << p;
+    ASSERT_GT(residual.data()[p], -off[p] - kRoundTripRoundingTolerance) << "pixel " << p;
+  }
+}
+
 TEST(EventSimulator, RejectsBadFramesAndTimes) {
   EventSimulator simulator(4, 5, SimulatorOptions());
   const Image frame = Image::Constant(4, 5, 0.5);

@@ -108,7 +108,9 @@ TEST(EvfsCli, InfoDescribesTheSharedSnippets) {
   EXPECT_NE(slider.output.find("240x180"), std::string::npos) << slider.output;
   EXPECT_NE(slider.output.find("events      16418"), std::string::npos) << slider.output;
   EXPECT_NE(slider.output.find("frames      2"), std::string::npos) << slider.output;
-  EXPECT_NE(slider.output.find("16418 events, 13 collision frames"), std::string::npos)
+  EXPECT_NE(slider.output.find("16418 events (7353 ON, 9065 OFF) at 11264 pixels (26.1 %), "
+                               "13 collision frames"),
+            std::string::npos)
       << slider.output;
 
   const CommandResult cups = RunEvfs("info --data=" + data + "/eslnet_cups_blur");
