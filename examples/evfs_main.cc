@@ -27,6 +27,7 @@
 #include "events/binning.h"
 #include "events/simulator.h"
 #include "examples/allocator_tuning.h"
+#include "examples/crash_guard.h"
 #include "examples/demo.h"
 #include "examples/reconstruct_job.h"
 #include "io/data_source.h"
@@ -418,13 +419,22 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "evfs: expected one command; see 'evfs --help'\n");
     return 2;
   }
-  try {
-    return evfs::RunCommand(argv[1]);
-  } catch (const evfs::Error& error) {
-    std::fprintf(stderr, "evfs %s: %s\n", argv[1], error.what());
-    return 2;
-  } catch (const std::exception& error) {
-    std::fprintf(stderr, "evfs %s: unexpected error: %s\n", argv[1], error.what());
-    return 1;
+  const std::string command = argv[1];
+  const auto run = [&command] {
+    try {
+      return evfs::RunCommand(command);
+    } catch (const evfs::Error& error) {
+      std::fprintf(stderr, "evfs %s: %s\n", command.c_str(), error.what());
+      return 2;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "evfs %s: unexpected error: %s\n", command.c_str(), error.what());
+      return 1;
+    }
+  };
+  // A corrupt .h5 file can crash libhdf5 itself: such commands run in a child process, whose
+  // crash becomes a user error (examples/crash_guard.h).
+  if (command != "simulate" && command != "demo" && evfs::IsHdf5Path(FLAGS_data)) {
+    return evfs::RunInChildProcess(run, "evfs " + command, FLAGS_data);
   }
+  return run();
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -336,6 +337,27 @@ TEST(EvfsCli, CorruptOrIncompleteHdf5IsAUserError) {
   const fs::path no_frames = scratch / "no_frames.h5";
   WriteHdf5(no_frames.string(), EventStream(), {}, {});
   ExpectUserError(reconstruct(no_frames), no_frames.string() + " has 0 frames", out);
+}
+
+// Two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation fault
+// (in H5AC_protect's block read, and in H5Aexists). The CLI runs HDF5 commands in a child
+// process (examples/crash_guard.h), so they end as a user error, not as a crash.
+TEST(EvfsCli, Hdf5FileThatCrashesLibhdf5IsAUserError) {
+  // Under AddressSanitizer the crash must stay a signal, not become a sanitizer report.
+  const char* asan = std::getenv("ASAN_OPTIONS");
+  const std::string asan_options = std::string(asan ? asan : "") + ":handle_segv=0";
+  setenv("ASAN_OPTIONS", asan_options.c_str(), 1);
+  const fs::path scratch = testing::ScratchDir("libhdf5_crash");
+  const fs::path out = scratch / "out";
+  for (const char* name : {"fuzz_libhdf5_segv_cache_read.h5", "fuzz_libhdf5_segv_attribute.h5"}) {
+    const std::string h5 = std::string(EVFS_TEST_SOURCE_DIR) + "/data/" + name;
+    const std::string expected = h5 + ": crashed (Segmentation fault) reading it";
+    ExpectUserError(RunEvfs("info --data=" + h5), expected, out);
+    ExpectUserError(RunEvfs("reconstruct --data=" + h5 +
+                            " --mode=interpolate --first=0 --last=1 --out=" + out.string()),
+                    expected, out);
+    ExpectUserError(RunEvfs("convert --data=" + h5 + " --out=" + out.string()), expected, out);
+  }
 }
 
 TEST(EvfsCli, UnwritableOutputIsAUserError) {
