@@ -157,6 +157,11 @@ std::vector<hsize_t> Dimensions(const H5Context& h5, hid_t dataset, const std::s
 // stopped early would read as zeros, and a corrupt extent could claim terabytes of them. Throws
 // unless the file stores what `dataset` (of extent `dims`) declares: some data at all, and all
 // of it when it is not compressed (a compressed size says nothing about the extent).
+//
+// Also throws for a number type whose bits do not fit in its bytes (precision + bit offset >
+// 8 · size): libhdf5 converts such values differently depending on where a read starts, so one
+// element would read as two values (the HDF5 fuzzer found an x of 32768 that read as 0 from a
+// later start).
 void CheckStored(const H5Context& h5, hid_t dataset, const std::string& name,
                  const std::vector<hsize_t>& dims) {
   const Handle type = h5.Check(H5Dget_type(dataset), H5Tclose, "unreadable type of " + name);
@@ -164,6 +169,18 @@ void CheckStored(const H5Context& h5, hid_t dataset, const std::string& name,
       h5.Check(H5Dget_create_plist(dataset), H5Pclose, "unreadable properties of " + name);
   const size_t value_bytes = H5Tget_size(type.get());
   if (value_bytes == 0) h5.Fail(InputError::Kind::kMalformed, "unreadable type of " + name);
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  if (type_class == H5T_INTEGER || type_class == H5T_FLOAT) {
+    const size_t precision = H5Tget_precision(type.get());
+    const int offset = H5Tget_offset(type.get());
+    if (precision == 0 || offset < 0 ||
+        precision + static_cast<size_t>(offset) > 8 * value_bytes) {
+      h5.Fail(InputError::Kind::kMalformed,
+              "corrupt type of " + name + ": " + std::to_string(precision) + " bits at bit offset " +
+                  std::to_string(offset) + " do not fit in " + std::to_string(value_bytes) +
+                  " bytes");
+    }
+  }
   // In long double: a corrupt extent can overflow 64 bits.
   long double declared_bytes = static_cast<long double>(value_bytes);
   for (const hsize_t dim : dims) declared_bytes *= static_cast<long double>(dim);

@@ -411,6 +411,18 @@ TEST(Hdf5IoTest, FuzzerFindingImageExtentWrapsIntIsAnInputError) {
                             "unreadable type of images/image000000001", 0);
 }
 
+// The file the HDF5 fuzzer found it with: events/xs holds 16-bit integers at bit offset 1 of a
+// 2-byte type, which libhdf5 converted differently depending on where a read started (event 20
+// read as x = 32768 in the whole file and as x = 0 from event 19 on).
+TEST(Hdf5IoTest, FuzzerFindingIntegerBitsBeyondTheirTypeIsAnInputError) {
+  const std::string path =
+      std::string(EVFS_TEST_SOURCE_DIR) + "/data/fuzz_integer_bits_beyond_type.h5";
+  testing::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kMalformed,
+                            "corrupt type of events/xs: 16 bits at bit offset 1 do not fit in 2 "
+                            "bytes",
+                            0);
+}
+
 TEST(Hdf5IoTest, UnwritablePathIsAnInputError) {
   const std::string path = testing::ScratchDir("h5_unwritable") + "/no/folder/out.h5";
   testing::ExpectInputError([&] { WriteHdf5(path, EventStream(), {}, {}); },
@@ -420,3 +432,4 @@ TEST(Hdf5IoTest, UnwritablePathIsAnInputError) {
 
 }  // namespace
 }  // namespace evfs
+
