@@ -205,6 +205,12 @@ int RunInfo() {
                 positive, window.size() - positive, pixels_fired,
                 100.0 * static_cast<double>(pixels_fired) / static_cast<double>(fired.size()),
                 collision.num_frames());
+    // A change of overall brightness between the frames (flicker, exposure or gain) that no
+    // event records is outside the per-pixel event model; this line shows it.
+    const double first_mean = source->ReadImage(FLAGS_first).mean();
+    const double last_mean = source->ReadImage(last).mean();
+    std::printf("brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", FLAGS_first,
+                first_mean, last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
   }
   return 0;
 }
