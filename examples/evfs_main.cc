@@ -11,7 +11,6 @@
 // flag) prints one line and exits with status 2.
 #include <unistd.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -34,6 +33,7 @@
 #include "io/frame_list.h"
 #include "io/image_io.h"
 #include "io/text_folder.h"
+#include "solver/activity_mask.h"
 
 // Input and output.
 DEFINE_string(data, "", "Data folder (Event Camera Dataset layout) or HDF5 event file.");
@@ -151,6 +151,29 @@ void Require(bool condition, const std::string& message) {
   if (!condition) throw InvalidArgumentError(message);
 }
 
+// The events between frames `first` and `last` (counts, polarities, the pixels that fired, the
+// collision frames) and the frames' change of mean brightness.
+void PrintWindow(const DataSource& source, int first, int last) {
+  const int64_t begin_ns = source.frames()[first].t_ns, end_ns = source.frames()[last].t_ns;
+  const EventStream window = source.ReadEvents(begin_ns, end_ns);
+  const EventFrames collision = BinByCollision(window, begin_ns, end_ns);
+  const size_t positive = window.CountPositive();
+  const ActivityMask fired(collision, /*radius_px=*/0);
+  std::printf("window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %lld pixels "
+              "(%.1f %%), %d collision frames\n",
+              first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(), positive,
+              window.size() - positive, static_cast<long long>(fired.num_active()),
+              100.0 * static_cast<double>(fired.num_active()) /
+                  static_cast<double>(fired.num_pixels()),
+              collision.num_frames());
+  // A change of overall brightness between the frames (flicker, exposure or gain) that no
+  // event records is outside the per-pixel event model; this line shows it.
+  const double first_mean = source.ReadImage(first).mean();
+  const double last_mean = source.ReadImage(last).mean();
+  std::printf("brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", first,
+              first_mean, last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
+}
+
 int RunInfo() {
   Require(!FLAGS_data.empty(), "info needs --data=DIR or --data=FILE.h5");
   const auto source = DataSource::Open(FLAGS_data);
@@ -190,27 +213,7 @@ int RunInfo() {
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
     Require(FLAGS_first < count && last < count && last > FLAGS_first,
             "--first/--last must be frame indices with first < last < " + std::to_string(count));
-    const int64_t begin_ns = frames[FLAGS_first].t_ns, end_ns = frames[last].t_ns;
-    const EventStream window = source->ReadEvents(begin_ns, end_ns);
-    const EventFrames collision = BinByCollision(window, begin_ns, end_ns);
-    const size_t positive = window.CountPositive();
-    std::vector<bool> fired(static_cast<size_t>(source->width()) * source->height(), false);
-    for (size_t i = 0; i < window.size(); ++i) {
-      fired[static_cast<size_t>(window.y(i)) * source->width() + window.x(i)] = true;
-    }
-    const auto pixels_fired = std::count(fired.begin(), fired.end(), true);
-    std::printf("window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %td pixels "
-                "(%.1f %%), %d collision frames\n",
-                FLAGS_first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(),
-                positive, window.size() - positive, pixels_fired,
-                100.0 * static_cast<double>(pixels_fired) / static_cast<double>(fired.size()),
-                collision.num_frames());
-    // A change of overall brightness between the frames (flicker, exposure or gain) that no
-    // event records is outside the per-pixel event model; this line shows it.
-    const double first_mean = source->ReadImage(FLAGS_first).mean();
-    const double last_mean = source->ReadImage(last).mean();
-    std::printf("brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", FLAGS_first,
-                first_mean, last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
+    PrintWindow(*source, FLAGS_first, last);
   }
   return 0;
 }
