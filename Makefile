@@ -16,7 +16,7 @@ build: deps
 
 # The main job: a synthetic scene through the whole pipeline, results in out/demo.
 run: build
-	./$(BUILD_DIR)/examples/evfs demo --out=out/demo
+	./$(BUILD_DIR)/examples/evfs demo --out=out/demo --overwrite
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

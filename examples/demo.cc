@@ -5,6 +5,7 @@
 #include <fstream>
 #include <vector>
 
+#include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
 #include "events/scene_synthesizer.h"
@@ -53,9 +54,9 @@ std::vector<FrameInfo> SharpFrames(const Video& video, std::vector<Image>* image
 
 }  // namespace
 
-int RunDemo(const std::string& out_dir) {
-  const fs::path out(out_dir);
-  fs::create_directories(out);
+int RunDemo(const std::string& folder, const std::string& shown_as) {
+  const fs::path out(folder);
+  const fs::path shown(shown_as);
 
   SceneOptions scene_options;
   scene_options.width = kWidth;
@@ -108,6 +109,7 @@ int RunDemo(const std::string& out_dir) {
   for (const DemoCase& demo_case : cases) {
     ReconstructRequest request;
     request.data_path = demo_case.data;
+    request.data_label = (shown / fs::path(demo_case.data).filename()).string();
     request.mode = demo_case.mode;
     request.first = demo_case.first;
     request.last = demo_case.last;
@@ -129,8 +131,14 @@ int RunDemo(const std::string& out_dir) {
                   result.time.total_s);
     table += row;
   }
-  std::printf("\n%s\nresults written to %s\n", table.c_str(), out.string().c_str());
-  std::ofstream(out / "results.md") << "# evfs demo\n\n" << table;
+  std::ofstream results(out / "results.md");
+  results << "# evfs demo\n\n" << table;
+  results.close();
+  if (!results) {
+    throw InputError(InputError::Kind::kUnwritable, (shown / "results.md").string(), 0,
+                     "cannot write the results table");
+  }
+  std::printf("\n%s\n", table.c_str());
   return 0;
 }
 

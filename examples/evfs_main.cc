@@ -31,14 +31,20 @@
 #include "examples/reconstruct_job.h"
 #include "io/data_source.h"
 #include "io/frame_list.h"
+#include "io/hdf5_io.h"
 #include "io/image_io.h"
+#include "io/output_target.h"
 #include "io/text_folder.h"
 #include "solver/activity_mask.h"
 
 // Input and output.
 DEFINE_string(data, "", "Data folder (Event Camera Dataset layout) or HDF5 event file.");
 DEFINE_string(frames, "", "simulate: folder with images.txt ('t path' lines) and the frames.");
-DEFINE_string(out, "", "Output folder (reconstruct, simulate, demo) or file (convert to .h5).");
+DEFINE_string(out, "", "Output folder (reconstruct, simulate, demo) or file (convert to .h5): "
+              "a new one, or an earlier output of the same command with --overwrite. Never "
+              "the root, current or home folder, nor the input or a folder around it.");
+DEFINE_bool(overwrite, false, "Replace --out when it holds an earlier output of the same command "
+            "(marked by OUT/.evfs-output, or an .h5 file evfs wrote); nothing else is replaced.");
 // Which frames.
 DEFINE_int32(first, -1, "0-based images.txt line of the first (or blurred) frame.");
 DEFINE_int32(last, -1,
@@ -151,6 +157,16 @@ void Require(bool condition, const std::string& message) {
   if (!condition) throw InvalidArgumentError(message);
 }
 
+// --out of `command`, checked (and its staging folder made) before any input is read.
+OutputOptions OutputFromFlags(const std::string& command, const std::string& input) {
+  OutputOptions options;
+  options.path = FLAGS_out;
+  options.command = command;
+  options.overwrite = FLAGS_overwrite;
+  options.inputs = {input};
+  return options;
+}
+
 // The events between frames `first` and `last` (counts, polarities, the pixels that fired, the
 // collision frames) and the frames' change of mean brightness.
 void PrintWindow(const DataSource& source, int first, int last) {
@@ -220,8 +236,15 @@ int RunInfo() {
 
 int RunConvert() {
   Require(!FLAGS_data.empty() && !FLAGS_out.empty(), "convert needs --data and --out");
-  ConvertRecording(FLAGS_data, FLAGS_out);
-  std::printf("wrote %s\n", FLAGS_out.c_str());
+  OutputOptions options = OutputFromFlags("convert", FLAGS_data);
+  if (IsHdf5Path(FLAGS_out)) {
+    options.kind = OutputOptions::Kind::kFile;
+    options.is_own_file = IsHdf5WrittenByEvfs;
+  }
+  OutputTarget out(options);
+  ConvertRecording(FLAGS_data, out.staging());
+  out.Commit();
+  std::printf("wrote %s\n", out.path().c_str());
   return 0;
 }
 
@@ -236,6 +259,7 @@ int RunSimulate() {
   options.seed = FLAGS_seed;
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
+  OutputTarget out(OutputFromFlags("simulate", FLAGS_frames));
 
   const std::filesystem::path folder(FLAGS_frames);
   std::vector<FrameInfo> frames = ReadFrameList((folder / "images.txt").string());
@@ -253,9 +277,10 @@ int RunSimulate() {
     video.AppendFrame(images.back(), frame.t_ns);
   }
   const EventStream events = SimulateEvents(video, options);
-  WriteDataFolder(FLAGS_out, events, frames, images);
+  WriteDataFolder(out.staging(), events, frames, images);
+  out.Commit();
   std::printf("simulated %zu events over %zu frames (%dx%d) into %s\n", events.size(),
-              frames.size(), video.width(), video.height(), FLAGS_out.c_str());
+              frames.size(), video.width(), video.height(), out.path().c_str());
   return 0;
 }
 
@@ -363,9 +388,11 @@ int RunReconstruct() {
   Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
   Require(FLAGS_first >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
   ReconstructRequest request = RequestFromFlags();
+  OutputTarget out(OutputFromFlags("reconstruct", FLAGS_data));
   if (FLAGS_progress || ::isatty(STDERR_FILENO)) request.progress = PrintProgress;
   ReconstructResult result = RunReconstruction(request);
-  WriteReconstruction(request, &result, FLAGS_out);
+  WriteReconstruction(request, &result, out.staging());
+  out.Commit();
 
   const MethodResult& run = result.run;
   std::printf("%s: %dx%d, %lld events, %d event frames, %d latent frames\n",
@@ -395,7 +422,7 @@ int RunReconstruct() {
               "total %.2f s\n",
               result.time.read_s, result.time.bin_s, result.time.build_s, result.time.solve_s,
               result.time.write_s, result.time.total_s);
-  std::printf("wrote %d frames to %s\n", result.output.num_frames(), FLAGS_out.c_str());
+  std::printf("wrote %d frames to %s\n", result.output.num_frames(), out.path().c_str());
   return 0;
 }
 
@@ -406,7 +433,11 @@ int RunCommand(const std::string& command) {
   if (command == "convert") return RunConvert();
   if (command == "demo") {
     Require(!FLAGS_out.empty(), "demo needs --out=DIR");
-    return RunDemo(FLAGS_out);
+    OutputTarget out(OutputFromFlags("demo", ""));
+    const int status = RunDemo(out.staging(), out.path());
+    out.Commit();
+    std::printf("results written to %s\n", out.path().c_str());
+    return status;
   }
   throw InvalidArgumentError("unknown command '" + command +
                              "': expected info, reconstruct, simulate, convert or demo "
@@ -439,10 +470,14 @@ int main(int argc, char** argv) {
       return 1;
     }
   };
-  // A corrupt .h5 file can crash libhdf5 itself: commands reading one run in a child process,
-  // whose crash becomes a user error (examples/crash_guard.h).
+  // Every command runs in a worker process: a signal or a crash there leaves no unfinished
+  // output (the parent removes it), and a corrupt .h5 file that crashes libhdf5 is a user error
+  // (examples/crash_guard.h). `convert --overwrite` opens the .h5 file it would replace.
+  std::string hdf5_path;
   if (evfs::IsHdf5Path(FLAGS_data)) {
-    return evfs::RunInChildProcess(run, "evfs " + command, FLAGS_data);
+    hdf5_path = FLAGS_data;
+  } else if (FLAGS_overwrite && evfs::IsHdf5Path(FLAGS_out)) {
+    hdf5_path = FLAGS_out;
   }
-  return run();
+  return evfs::RunInChildProcess(run, "evfs " + command, hdf5_path);
 }

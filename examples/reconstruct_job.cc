@@ -1,7 +1,5 @@
 #include "examples/reconstruct_job.h"
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -286,7 +284,7 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   JsonWriter json;
   json.BeginObject();
   json.Field("mode", ModeName(result.mode));
-  json.Field("data", request.data_path);
+  json.Field("data", request.data_label.empty() ? request.data_path : request.data_label);
   json.Field("width", result.width);
   json.Field("height", result.height);
   json.Field("events", result.events);
@@ -359,42 +357,29 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
 }
 
 void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
-                         const std::string& out_dir) {
+                         const std::string& folder) {
   const auto write_start = Clock::now();
-  const fs::path out = fs::absolute(fs::path(out_dir)).lexically_normal();
-  const fs::path partial = out.parent_path() / (out.filename().string() + ".partial-" +
-                                                std::to_string(::getpid()));
+  const fs::path out(folder);
   std::error_code ec;
-  fs::remove_all(partial, ec);
-  if (!fs::create_directories(partial / "frames", ec) || ec) {
+  fs::create_directories(out / "frames", ec);
+  if (ec) {
     throw InputError(InputError::Kind::kUnwritable, out.string(), 0,
                      "cannot create the output folder (" + ec.message() + ")");
   }
-  try {
-    char name[32];
-    for (int t = 0; t < result->output.num_frames(); ++t) {
-      std::snprintf(name, sizeof(name), "%06d.png", t);
-      WriteGreyPng16((partial / "frames" / name).string(), result->output.frame(t));
-    }
-    WriteTimestampsTxt((partial / "timestamps.txt").string(), result->output.timestamps_ns());
-    result->time.write_s = SecondsSince(write_start);
-    result->time.total_s += result->time.write_s;
-    std::ofstream summary(partial / "summary.json");
-    summary << SummaryJson(request, *result) << "\n";
-    if (!summary) {
-      throw InputError(InputError::Kind::kUnwritable, (out / "summary.json").string(), 0,
-                       "cannot write the summary");
-    }
-    summary.close();
-    fs::remove_all(out, ec);
-    fs::rename(partial, out, ec);
-    if (ec) {
-      throw InputError(InputError::Kind::kUnwritable, out.string(), 0,
-                       "cannot move the finished output into place (" + ec.message() + ")");
-    }
-  } catch (...) {
-    fs::remove_all(partial, ec);
-    throw;
+  char name[32];
+  for (int t = 0; t < result->output.num_frames(); ++t) {
+    std::snprintf(name, sizeof(name), "%06d.png", t);
+    WriteGreyPng16((out / "frames" / name).string(), result->output.frame(t));
+  }
+  WriteTimestampsTxt((out / "timestamps.txt").string(), result->output.timestamps_ns());
+  result->time.write_s = SecondsSince(write_start);
+  result->time.total_s += result->time.write_s;
+  std::ofstream summary(out / "summary.json");
+  summary << SummaryJson(request, *result) << "\n";
+  summary.close();
+  if (!summary) {
+    throw InputError(InputError::Kind::kUnwritable, (out / "summary.json").string(), 0,
+                     "cannot write the summary");
   }
 }
 

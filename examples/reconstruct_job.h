@@ -20,7 +20,8 @@ Mode ParseMode(const std::string& name);
 const char* ModeName(Mode mode);
 
 struct ReconstructRequest {
-  std::string data_path;  // data folder or HDF5 file
+  std::string data_path;   // data folder or HDF5 file
+  std::string data_label;  // how summary.json names the data ("": data_path)
   Mode mode = Mode::kPredict;
   int first = 0;    // images.txt line (0-based) of the first / blurred frame
   int last = -1;    // interpolate: the last frame; predict: the frame whose time ends the window
@@ -65,11 +66,12 @@ struct ReconstructResult {
 /// Runs the job. Throws evfs::Error (InputError, InvalidArgumentError) on bad input.
 ReconstructResult RunReconstruction(const ReconstructRequest& request);
 
-/// Writes OUT/frames/NNNNNN.png (16-bit grey), OUT/timestamps.txt and OUT/summary.json. The
-/// folder appears whole or not at all: it is written under a temporary name and renamed.
-/// Fills result->time.write_s and total_s before writing the summary.
+/// Writes `folder`/frames/NNNNNN.png (16-bit grey), timestamps.txt and summary.json into a new
+/// or empty folder: the staging folder of an OutputTarget (io/output_target.h), which makes the
+/// output appear whole or not at all. Fills result->time.write_s and total_s before writing the
+/// summary.
 void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
-                         const std::string& out_dir);
+                         const std::string& folder);
 
 /// summary.json's text (DESIGN.md §8).
 std::string SummaryJson(const ReconstructRequest& request, const ReconstructResult& result);

@@ -1,8 +1,11 @@
 #include "io/hdf5_io.h"
 
 #include <hdf5.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -29,6 +32,9 @@ constexpr char kExposureStart[] = "exposure_start";
 constexpr char kExposureEnd[] = "exposure_end";
 constexpr char kPath[] = "path";
 constexpr char kTsUnit[] = "ts_unit";
+// Root attribute naming the writer: only a file carrying it may be replaced by `evfs convert`.
+constexpr char kWrittenBy[] = "written_by";
+constexpr char kEvfs[] = "evfs";
 // Image dataset names appear in error messages, which must stay one short line; tools write
 // names like image000000000.
 constexpr size_t kMaxImageNameBytes = 64;
@@ -36,6 +42,42 @@ constexpr size_t kMaxImageNameBytes = 64;
 constexpr hsize_t kMaxImageSide = 65536;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
+
+// The thread reading a user's file in libhdf5 now (its kernel thread id), 0 when none: read by
+// InLibhdf5() in a crash signal handler, hence a lock-free atomic.
+std::atomic<pid_t> libhdf5_reader{0};
+static_assert(std::atomic<pid_t>::is_always_lock_free, "read in a signal handler");
+
+pid_t ThreadId() { return static_cast<pid_t>(syscall(SYS_gettid)); }
+
+// While alive, libhdf5 prints no error stack to stderr (evfs reports its own InputError
+// instead); the handler installed before, if any, is restored after, so that other code in the
+// process using libhdf5 keeps its own reporting.
+class ScopedHdf5ErrorsSilenced {
+ public:
+  ScopedHdf5ErrorsSilenced()
+      : restore_(H5Eget_auto2(H5E_DEFAULT, &previous_, &previous_data_) >= 0) {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~ScopedHdf5ErrorsSilenced() {
+    if (restore_) H5Eset_auto2(H5E_DEFAULT, previous_, previous_data_);
+  }
+  ScopedHdf5ErrorsSilenced(const ScopedHdf5ErrorsSilenced&) = delete;
+  ScopedHdf5ErrorsSilenced& operator=(const ScopedHdf5ErrorsSilenced&) = delete;
+
+ private:
+  H5E_auto2_t previous_ = nullptr;
+  void* previous_data_ = nullptr;
+  bool restore_;
+};
+
+// Around every stretch of libhdf5 calls reading a file the user gave: errors silenced, and a
+// crash counted as the file's (ScopedLibhdf5Read).
+class ReadingWithLibhdf5 {
+ private:
+  ScopedHdf5ErrorsSilenced silenced_;
+  ScopedLibhdf5Read reading_;
+};
 
 // Owns one HDF5 identifier and closes it with the matching H5?close.
 class Handle {
@@ -60,16 +102,16 @@ class Handle {
 
  private:
   void Reset() {
-    if (id_ >= 0) close_(id_);
+    if (id_ >= 0) {
+      const ScopedHdf5ErrorsSilenced silenced;
+      close_(id_);
+    }
     id_ = -1;
   }
 
   hid_t id_ = -1;
   Closer close_ = nullptr;
 };
-
-// HDF5 prints a stack of errors to stderr by default; evfs reports its own InputError instead.
-void SilenceHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
 // Calls into HDF5 for one file, turning every failure into an InputError naming the file and
 // the object involved.
@@ -216,24 +258,47 @@ void ReadSlab(const H5Context& h5, hid_t dataset, const std::string& name, hid_t
 
 }  // namespace
 
+ScopedLibhdf5Read::ScopedLibhdf5Read() : previous_(libhdf5_reader.exchange(ThreadId())) {}
+
+ScopedLibhdf5Read::~ScopedLibhdf5Read() { libhdf5_reader.store(previous_); }
+
+bool InLibhdf5() {
+  const pid_t reader = libhdf5_reader.load();
+  return reader != 0 && reader == ThreadId();
+}
+
 // ---------------------------------------------------------------------------------------------
 
 class Hdf5DataSource::File {
  public:
   explicit File(const std::string& path) : h5_(path, InputError::Kind::kMalformed) {
-    SilenceHdf5Errors();
     std::error_code error;
-    if (!std::filesystem::is_regular_file(path, error)) {
+    if (!std::filesystem::exists(path, error)) {
       h5_.Fail(InputError::Kind::kMissingFile, "HDF5 file does not exist");
     }
-    if (H5Fis_hdf5(path.c_str()) <= 0) {
-      h5_.Fail(InputError::Kind::kMalformed, "not an HDF5 file (corrupt or truncated?)");
+    if (!std::filesystem::is_regular_file(path, error)) {
+      h5_.Fail(InputError::Kind::kMalformed,
+               "not a regular file (a folder, FIFO or device): expected an HDF5 file");
     }
-    file_ = h5_.Check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose,
-                      "cannot open the HDF5 file (corrupt or truncated?)");
-    OpenEvents();
-    ReadSensorResolution();
-    ReadFrames();
+    const ReadingWithLibhdf5 reading;
+    try {
+      if (H5Fis_hdf5(path.c_str()) <= 0) {
+        h5_.Fail(InputError::Kind::kMalformed, "not an HDF5 file (corrupt or truncated?)");
+      }
+      file_ = h5_.Check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose,
+                        "cannot open the HDF5 file (corrupt or truncated?)");
+      OpenEvents();
+      ReadSensorResolution();
+      ReadFrames();
+    } catch (...) {
+      CloseAll();
+      throw;
+    }
+  }
+
+  ~File() {
+    const ReadingWithLibhdf5 reading;
+    CloseAll();
   }
 
   const H5Context& h5() const { return h5_; }
@@ -249,6 +314,7 @@ class Hdf5DataSource::File {
   }
 
   int64_t TimeAt(int64_t index) const {
+    const ReadingWithLibhdf5 reading;
     int64_t t_ns = 0;
     ReadTimes(index, 1, &t_ns);
     return t_ns;
@@ -271,10 +337,13 @@ class Hdf5DataSource::File {
       xs.resize(count);
       ys.resize(count);
       ps.resize(count);
-      ReadTimes(block, count, t_ns.data());
-      ReadSlab(h5_, xs_.get(), "events/xs", H5T_NATIVE_INT32, block, count, xs.data());
-      ReadSlab(h5_, ys_.get(), "events/ys", H5T_NATIVE_INT32, block, count, ys.data());
-      ReadPolarities(block, count, ps.data());
+      {
+        const ReadingWithLibhdf5 reading;
+        ReadTimes(block, count, t_ns.data());
+        ReadSlab(h5_, xs_.get(), "events/xs", H5T_NATIVE_INT32, block, count, xs.data());
+        ReadSlab(h5_, ys_.get(), "events/ys", H5T_NATIVE_INT32, block, count, ys.data());
+        ReadPolarities(block, count, ps.data());
+      }
       for (int64_t i = 0; i < count; ++i) {
         const int64_t index = block + i;
         if (xs[i] < 0 || xs[i] >= x_limit)
@@ -298,6 +367,7 @@ class Hdf5DataSource::File {
   }
 
   Image ReadImage(int index) const {
+    const ReadingWithLibhdf5 reading;
     const std::string name = std::string(kImagesGroup) + "/" + image_datasets_[index];
     const Handle dataset = h5_.Check(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose,
                                      "cannot open " + name);
@@ -335,6 +405,16 @@ class Hdf5DataSource::File {
   }
 
  private:
+  // Closes every HDF5 object, the file last.
+  void CloseAll() {
+    ps_enum_type_ = Handle();
+    ps_ = Handle();
+    ts_ = Handle();
+    ys_ = Handle();
+    xs_ = Handle();
+    file_ = Handle();
+  }
+
   [[noreturn]] void FailEvent(InputError::Kind kind, const char* dataset, int64_t index,
                               const std::string& what) const {
     h5_.Fail(kind, std::string("events/") + dataset + "[" + std::to_string(index) + "]: " + what);
@@ -611,7 +691,6 @@ namespace {
 class Hdf5Writer {
  public:
   explicit Hdf5Writer(const std::string& path) : h5_(path, InputError::Kind::kUnwritable) {
-    SilenceHdf5Errors();
     file_ = h5_.Check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
                       "cannot create the HDF5 file");
   }
@@ -692,6 +771,8 @@ void WriteHdf5(const std::string& path, const EventStream& events,
     throw InvalidArgumentError("WriteHdf5: " + std::to_string(frames.size()) + " frames but " +
                                std::to_string(images.size()) + " images");
   }
+  // A crash here is not the user's file's doing: errors are silenced, the region not marked.
+  const ScopedHdf5ErrorsSilenced silenced;
   Hdf5Writer writer(path);
 
   int height = events.height();
@@ -705,6 +786,8 @@ void WriteHdf5(const std::string& path, const EventStream& events,
     writer.WriteAttribute(writer.file(), kSensorResolution, H5T_STD_I32LE, H5T_NATIVE_INT32, 2,
                           resolution);
   }
+
+  writer.WriteStringAttribute(writer.file(), kWrittenBy, kEvfs);
 
   const Handle events_group = writer.CreateGroup(kEventsGroup);
   const std::vector<hsize_t> event_dims = {static_cast<hsize_t>(events.size())};
@@ -761,6 +844,22 @@ void WriteHdf5(const std::string& path, const EventStream& events,
     }
   }
   writer.Close();
+}
+
+bool IsHdf5WrittenByEvfs(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return false;
+  try {
+    const H5Context h5(path, InputError::Kind::kMalformed);
+    const ReadingWithLibhdf5 reading;
+    if (H5Fis_hdf5(path.c_str()) <= 0) return false;
+    const Handle file =
+        h5.Check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "cannot open");
+    return HasAttribute(file.get(), kWrittenBy) &&
+           ReadStringAttribute(h5, file.get(), kWrittenBy, "the file's") == kEvfs;
+  } catch (const InputError&) {
+    return false;
+  }
 }
 
 }  // namespace evfs

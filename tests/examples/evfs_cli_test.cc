@@ -17,6 +17,7 @@
 #include "io/hdf5_io.h"
 #include "io/image_io.h"
 #include "io/text_folder.h"
+#include "tests/examples/cli_test_util.h"
 #include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
 
@@ -25,81 +26,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout, then stderr
-  std::string errors;  // stderr alone
-};
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-CommandResult RunEvfs(const std::string& arguments) {
-  fs::create_directories(EVFS_TEST_TMP_DIR);
-  const fs::path stderr_file = fs::path(EVFS_TEST_TMP_DIR) / "stderr.txt";
-  const std::string command =
-      std::string(EVFS_BINARY) + " " + arguments + " 2>" + stderr_file.string();
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.errors = ReadFile(stderr_file);
-  result.output += result.errors;
-  return result;
-}
-
-// Longest error line accepted: the paths it names plus a short explanation, even when the input
-// held a megabyte line (input is quoted cut short, io/message_excerpt.h).
-constexpr size_t kMaxErrorLineBytes = 600;
-
-// A user error: exit status 2, exactly one short line on stderr holding `expected` (the file
-// and line it names, or the flag), and nothing under `out` or beside it (no partial folder).
-void ExpectUserError(const CommandResult& result, const std::string& expected,
-                     const fs::path& out) {
-  EXPECT_EQ(result.exit_code, 2) << result.output;
-  EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
-  EXPECT_EQ(result.errors.back(), '\n') << result.errors;
-  EXPECT_LT(result.errors.size(), kMaxErrorLineBytes) << result.errors.substr(0, 1000);
-  EXPECT_NE(result.errors.find(expected), std::string::npos) << result.errors;
-  EXPECT_FALSE(fs::exists(out)) << out;
-  for (const auto& entry : fs::directory_iterator(out.parent_path())) {
-    EXPECT_NE(entry.path().filename().string().rfind(out.filename().string() + ".partial", 0), 0u)
-        << "left behind: " << entry.path();
-  }
-}
-
-// A small synthetic recording written as a data folder: 5 frames 5 ms apart, events simulated
-// from a 1 kHz rendering.
-std::string WriteSyntheticFolder(const std::string& scratch) {
-  SceneOptions scene;
-  scene.width = 40;
-  scene.height = 32;
-  scene.duration_s = 0.02;
-  scene.num_shapes = 2;
-  scene.min_shape_size_px = 5.0;
-  scene.max_shape_size_px = 10.0;
-  const Video rendered = SceneSynthesizer(scene).RenderAtRate(1000.0);
-  const EventStream events = SimulateEvents(rendered, SimulatorOptions());
-  std::vector<FrameInfo> frames;
-  std::vector<Image> images;
-  for (int t = 0; t < rendered.num_frames(); t += 5) {
-    FrameInfo info;
-    info.t_ns = rendered.timestamp_ns(t);
-    info.path = "images/frame_" + std::to_string(t) + ".png";
-    frames.push_back(info);
-    images.push_back(rendered.frame(t));
-  }
-  const std::string folder = (fs::path(scratch) / "data").string();
-  WriteDataFolder(folder, events, frames, images);
-  return folder;
-}
+using test::CommandResult;
+using test::ExpectUserError;
+using test::ReadFile;
+using test::RunEvfs;
+using test::WriteSyntheticFolder;
 
 TEST(EvfsCli, InfoDescribesTheSharedSnippets) {
   EVFS_REQUIRE_SHARED_DATA(data);
@@ -372,13 +303,13 @@ TEST(EvfsCli, UnwritableOutputIsAUserError) {
                                        " --mode=predict --first=0 --out=" + out.string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
-  EXPECT_NE(result.errors.find(out.string() + ": cannot create the output folder"),
+  EXPECT_NE(result.errors.find(out.string() + ": cannot create the output: "),
             std::string::npos)
       << result.errors;
   const CommandResult convert =
       RunEvfs("convert --data=" + data.string() + " --out=" + (scratch / "file/x.h5").string());
   EXPECT_EQ(convert.exit_code, 2) << convert.output;
-  EXPECT_NE(convert.errors.find("file/x.h5: cannot create the HDF5 file"), std::string::npos)
+  EXPECT_NE(convert.errors.find("file/x.h5: cannot create the output: "), std::string::npos)
       << convert.errors;
 }
 

@@ -1,0 +1,93 @@
+// Where a command writes: checked before any work, written under a temporary name, moved into
+// place at the end, and never anything evfs did not create itself.
+//
+//   OutputTarget out(options);            // refuses a dangerous --out in milliseconds
+//   WriteEverything(out.staging());       // a fresh folder (or file name) beside --out
+//   out.Commit();                          // marker, then the earlier output is replaced
+//
+// An output folder is marked as evfs's by OUT/.evfs-output, written last, which names the
+// command ("evfs reconstruct"). An existing OUT is replaced only when it is an empty folder, or
+// an earlier output of the same command and the user asked to overwrite it. A file output (an
+// .h5 file) is recognised by a predicate the caller gives (the HDF5 writer's own attribute).
+// Until Commit() the staging path is removed on every failure (the destructor) and when the
+// process dies (SIGINT, SIGTERM, SIGHUP, a crash: io/signal_cleanup.h); the earlier output stays
+// untouched until the new one is complete, and then one atomic rename swaps them.
+#ifndef EVFS_IO_OUTPUT_TARGET_H_
+#define EVFS_IO_OUTPUT_TARGET_H_
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace evfs {
+
+class ScopedCleanupPath;
+
+/// Name of the marker file in every output folder evfs writes.
+extern const char kOutputMarkerFile[];
+
+/// A folder an output must never be, nor contain.
+struct ProtectedFolder {
+  std::string path;
+  std::string what;  // "the current folder": how a refusal names it
+};
+
+/// The file-system root, the current folder and the home folder (from $HOME and the password
+/// database).
+std::vector<ProtectedFolder> DefaultProtectedFolders();
+
+struct OutputOptions {
+  enum class Kind {
+    kFolder,  // OUT is a folder the command fills
+    kFile,    // OUT is one file (convert to .h5)
+  };
+
+  std::string path;     // --out as given
+  std::string command;  // the command writing it ("reconstruct"): the marker's content
+  Kind kind = Kind::kFolder;
+  bool overwrite = false;           // replace an earlier output of the same command
+  std::vector<std::string> inputs;  // OUT may neither be, lie inside, nor contain any of them
+  std::vector<ProtectedFolder> protected_folders = DefaultProtectedFolders();
+  /// kFile: whether an existing file at OUT is an earlier output of this command.
+  std::function<bool(const std::string& path)> is_own_file;
+};
+
+class OutputTarget {
+ public:
+  /// Checks `options.path` and creates the staging folder (kFolder) or an empty staging file
+  /// (kFile) beside it, creating missing parent folders. Throws InvalidArgumentError for a path
+  /// evfs must not write (naming the reason) and InputError(kUnwritable) when it cannot.
+  explicit OutputTarget(OutputOptions options);
+  /// Removes the staging path and the parent folders it created, unless committed.
+  ~OutputTarget();
+  OutputTarget(const OutputTarget&) = delete;
+  OutputTarget& operator=(const OutputTarget&) = delete;
+
+  /// The final path, absolute and normalised ("out/" and "out" are the same).
+  const std::string& path() const { return path_; }
+  /// Where to write: a new empty folder, or a file name in the same folder as path().
+  const std::string& staging() const { return staging_; }
+
+  /// Marks the staging folder as this command's output and moves it to path(). An earlier
+  /// output is swapped out in one atomic rename (RENAME_EXCHANGE; where the file system lacks
+  /// it, moved aside first) and then removed. Throws InputError(kUnwritable) when the move fails
+  /// (the earlier output is then still in place) and InvalidArgumentError when something that
+  /// evfs did not write appeared at path() meanwhile.
+  void Commit();
+
+ private:
+  // Throws unless what is at path_ now may be replaced.
+  void CheckExisting() const;
+
+  OutputOptions options_;
+  std::string path_;
+  std::string staging_;
+  std::vector<std::string> created_parents_;  // deepest last
+  std::unique_ptr<ScopedCleanupPath> cleanup_;
+  bool committed_ = false;
+};
+
+}  // namespace evfs
+
+#endif  // EVFS_IO_OUTPUT_TARGET_H_

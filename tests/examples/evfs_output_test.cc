@@ -1,0 +1,311 @@
+// What `evfs` may write and replace, end to end: every command that writes, against the cases
+// that once deleted user files (issue 14). Each test works in a sandbox folder of its own, with
+// stand-ins for the home folder, the current folder and the input; no test names a real system
+// path as --out.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "io/output_target.h"
+#include "tests/examples/cli_test_util.h"
+#include "tests/io/io_test_util.h"
+#include "tests/test_data.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+
+using test::CommandResult;
+using test::ExpectNoStagingLeft;
+using test::ReadFile;
+using test::RunEvfs;
+using test::WriteSyntheticFolder;
+
+// A sandbox: a synthetic recording in data/, stand-ins for home and the current folder, and a
+// user's folder of precious files.
+struct Sandbox {
+  explicit Sandbox(const std::string& name) : root(testing::ScratchDir("output_" + name)) {
+    data = WriteSyntheticFolder(root.string());
+    for (const char* folder : {"home", "cwd/deeper", "thesis"}) fs::create_directories(root / folder);
+    testing::WriteFile((root / "thesis/chapter1.tex").string(), "precious");
+  }
+
+  // Runs evfs in the stand-in current folder with the stand-in home folder.
+  CommandResult Run(const std::string& arguments) const {
+    return RunEvfs(arguments,
+                   "cd " + (root / "cwd/deeper").string() + " && HOME=" + (root / "home").string() +
+                       " ");
+  }
+
+  std::string Reconstruct(const fs::path& out) const {
+    return "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=1 --out=" +
+           out.string();
+  }
+
+  // Every writing command, with --out=`out`.
+  std::vector<std::string> AllCommands(const fs::path& out) const {
+    return {Reconstruct(out), "simulate --frames=" + data + " --out=" + out.string(),
+            "convert --data=" + data + " --out=" + out.string(), "demo --out=" + out.string()};
+  }
+
+  // Fails the test unless the recording and the user's files are as they were made.
+  void ExpectUntouched() const {
+    EXPECT_EQ(ReadFile((root / "thesis/chapter1.tex").string()), "precious");
+    EXPECT_TRUE(fs::exists(fs::path(data) / "events.txt"));
+    EXPECT_TRUE(fs::exists(fs::path(data) / "images.txt"));
+    for (const char* folder : {"home", "cwd/deeper"}) {
+      EXPECT_TRUE(fs::is_directory(root / folder)) << folder;
+      EXPECT_TRUE(fs::is_empty(root / folder)) << folder;
+    }
+  }
+
+  fs::path root;
+  std::string data;
+};
+
+// Exit status 2, one line holding `expected`.
+void ExpectRefused(const CommandResult& result, const std::string& expected) {
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
+  EXPECT_NE(result.errors.find(expected), std::string::npos) << result.errors;
+}
+
+TEST(EvfsOutput, AFolderOfUnrelatedFilesIsNeverReplaced) {
+  const Sandbox sandbox("unrelated");
+  for (const std::string& command : sandbox.AllCommands(sandbox.root / "thesis")) {
+    for (const char* overwrite : {"", " --overwrite"}) {
+      SCOPED_TRACE(command + overwrite);
+      ExpectRefused(sandbox.Run(command + overwrite), "holds files evfs did not write");
+    }
+  }
+  sandbox.ExpectUntouched();
+  ExpectNoStagingLeft(sandbox.root / "thesis");
+}
+
+TEST(EvfsOutput, TheInputAFolderInsideItAndOneAroundItAreRefused) {
+  const Sandbox sandbox("input");
+  const fs::path data = sandbox.data;
+  const fs::path outer = sandbox.root / "outer";
+  fs::create_directories(outer);
+  fs::copy(data, outer / "recording", fs::copy_options::recursive);
+  const auto expect_refused = [&sandbox](const std::string& input, const fs::path& out) {
+    for (const std::string& command :
+         {"reconstruct --data=" + input + " --mode=predict --first=0 --out=" + out.string(),
+          "simulate --frames=" + input + " --out=" + out.string(),
+          "convert --data=" + input + " --out=" + out.string()}) {
+      SCOPED_TRACE(command);
+      const CommandResult result = sandbox.Run(command + " --overwrite");
+      EXPECT_EQ(result.exit_code, 2) << result.output;
+      EXPECT_NE(result.errors.find("the input"), std::string::npos) << result.errors;
+    }
+  };
+  for (const fs::path& out : {data, data / "images", data / "new"}) {
+    expect_refused(data.string(), out);
+  }
+  expect_refused((outer / "recording").string(), outer);
+  EXPECT_FALSE(fs::exists(data / "new"));
+  EXPECT_TRUE(fs::exists(outer / "recording/events.txt"));
+  sandbox.ExpectUntouched();
+}
+
+TEST(EvfsOutput, TheCurrentAndHomeFoldersAndTheirParentsAreRefused) {
+  const Sandbox sandbox("protected");
+  const std::string home = (sandbox.root / "home").string();
+  for (const std::string& out : {std::string("."), std::string(".."), std::string("./"),
+                                 std::string("../.."), home, home + "/"}) {
+    for (const std::string& command : sandbox.AllCommands(out)) {
+      SCOPED_TRACE(command);
+      const CommandResult result = sandbox.Run(command + " --overwrite");
+      EXPECT_EQ(result.exit_code, 2) << result.output;
+      EXPECT_NE(result.errors.find("which evfs never replaces"), std::string::npos)
+          << result.errors;
+    }
+  }
+  sandbox.ExpectUntouched();
+  EXPECT_EQ(std::distance(fs::directory_iterator(sandbox.root / "cwd"), fs::directory_iterator()),
+            1);
+}
+
+TEST(EvfsOutput, AnExistingFileIsNeverReplaced) {
+  const Sandbox sandbox("file");
+  const fs::path notes = sandbox.root / "notes.txt";
+  const fs::path recording = sandbox.root / "recording.h5";
+  testing::WriteFile(notes.string(), "mine");
+  testing::WriteFile(recording.string(), "not even HDF5, but mine");
+  for (const std::string& command : sandbox.AllCommands(notes)) {
+    SCOPED_TRACE(command);
+    ExpectRefused(sandbox.Run(command + " --overwrite"), "refusing --out=");
+  }
+  ExpectRefused(sandbox.Run("convert --data=" + sandbox.data + " --out=" + recording.string() +
+                            " --overwrite"),
+                "the file exists and evfs did not write it");
+  EXPECT_EQ(ReadFile(notes.string()), "mine");
+  EXPECT_EQ(ReadFile(recording.string()), "not even HDF5, but mine");
+  ExpectNoStagingLeft(notes);
+  ExpectNoStagingLeft(recording);
+}
+
+TEST(EvfsOutput, NewFoldersWithTrailingSlashesOrMissingParentsAreMade) {
+  const Sandbox sandbox("new");
+  const CommandResult reconstruct = sandbox.Run(sandbox.Reconstruct("../fresh/"));
+  ASSERT_EQ(reconstruct.exit_code, 0) << reconstruct.output;
+  const fs::path fresh = sandbox.root / "cwd/fresh";
+  EXPECT_TRUE(fs::exists(fresh / "frames/000000.png"));
+  EXPECT_EQ(ReadFile((fresh / kOutputMarkerFile).string()), "evfs reconstruct\n");
+  for (const char* out : {"a/b/converted.h5", "c/d/converted", "e/f/simulated"}) {
+    const std::string command = std::string(out).find("simulated") != std::string::npos
+                                    ? "simulate --frames="
+                                    : "convert --data=";
+    const CommandResult result =
+        sandbox.Run(command + sandbox.data + " --out=" + (sandbox.root / out).string());
+    EXPECT_EQ(result.exit_code, 0) << out << ": " << result.output;
+    EXPECT_TRUE(fs::exists(sandbox.root / out)) << out;
+  }
+  const CommandResult info = sandbox.Run("info --data=" + (sandbox.root / "a/b/converted.h5").string());
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+}
+
+TEST(EvfsOutput, AnEarlierOutputIsReplacedWholeAndOnlyWithOverwrite) {
+  const Sandbox sandbox("replace");
+  const fs::path sim = sandbox.root / "sim";
+  const std::string simulate = "simulate --frames=" + sandbox.data + " --out=" + sim.string();
+  ASSERT_EQ(sandbox.Run(simulate).exit_code, 0);
+  // A file of an older run (exposures.txt once survived and changed how the data was read).
+  testing::WriteFile((sim / "exposures.txt").string(), "images/frame_0.png 0 0.001\n");
+  ExpectRefused(sandbox.Run(simulate), "pass --overwrite to replace it");
+  EXPECT_TRUE(fs::exists(sim / "exposures.txt"));
+  ASSERT_EQ(sandbox.Run(simulate + " --overwrite").exit_code, 0);
+  EXPECT_FALSE(fs::exists(sim / "exposures.txt")) << "an old file was mixed into the new output";
+  EXPECT_TRUE(fs::exists(sim / "events.txt"));
+
+  // Another command's output is not replaced, even with --overwrite.
+  ExpectRefused(sandbox.Run(sandbox.Reconstruct(sim) + " --overwrite"),
+                "holds the output of 'evfs simulate'");
+
+  const fs::path h5 = sandbox.root / "recording.h5";
+  const std::string convert = "convert --data=" + sandbox.data + " --out=" + h5.string();
+  ASSERT_EQ(sandbox.Run(convert).exit_code, 0);
+  ExpectRefused(sandbox.Run(convert), "pass --overwrite");
+  const CommandResult again = sandbox.Run(convert + " --overwrite");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  ExpectNoStagingLeft(sim);
+  ExpectNoStagingLeft(h5);
+  sandbox.ExpectUntouched();
+}
+
+TEST(EvfsOutput, ABadOutFailsBeforeAnyInputIsRead) {
+  const Sandbox sandbox("early");
+  testing::WriteFile((sandbox.root / "file").string(), "a file");
+  const std::string missing = (sandbox.root / "no_such_recording").string();
+  const std::string bad_out = (sandbox.root / "file/out").string();
+  for (const std::string& command :
+       {"reconstruct --data=" + missing + " --mode=predict --first=0 --out=" + bad_out,
+        "simulate --frames=" + missing + " --out=" + bad_out,
+        "convert --data=" + missing + " --out=" + bad_out,
+        "reconstruct --data=" + missing + " --mode=predict --first=0 --out=" +
+            (sandbox.root / "thesis").string()}) {
+    SCOPED_TRACE(command);
+    const CommandResult result = sandbox.Run(command);
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_EQ(result.errors.find("no_such_recording:"), std::string::npos)
+        << "read the input before checking --out: " << result.errors;
+  }
+  sandbox.ExpectUntouched();
+}
+
+// Starts evfs with `arguments` in the background, output to files in `folder`.
+pid_t StartEvfs(const std::vector<std::string>& arguments, const fs::path& folder) {
+  const pid_t pid = fork();
+  if (pid != 0) return pid;
+  const std::string out = (folder / "stdout.txt").string();
+  const std::string err = (folder / "stderr.txt").string();
+  if (!freopen(out.c_str(), "w", stdout) || !freopen(err.c_str(), "w", stderr)) _exit(120);
+  std::vector<char*> argv = {const_cast<char*>(EVFS_BINARY)};
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  execv(EVFS_BINARY, argv.data());
+  _exit(121);
+}
+
+// The staging folder of --out=`out` once it holds `frame`, or "" after `timeout`.
+fs::path WaitForStagedFrame(const fs::path& out, const std::string& frame,
+                            std::chrono::seconds timeout) {
+  const std::string prefix = "." + out.filename().string() + ".evfs-tmp-";
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const auto& entry : fs::directory_iterator(out.parent_path())) {
+      if (entry.path().filename().string().rfind(prefix, 0) == 0 &&
+          fs::exists(entry.path() / "frames" / frame)) {
+        return entry.path();
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return "";
+}
+
+// A signal while evfs writes frames (thousands of them, at --fps=1000000) over an earlier
+// output: evfs dies of that signal, its staging folder is gone and the earlier output is whole.
+void ExpectSignalLeavesTheEarlierOutput(int signal_number, bool hdf5) {
+  const Sandbox sandbox("signal_" + std::to_string(signal_number) + (hdf5 ? "_h5" : ""));
+  std::string data = sandbox.data;
+  if (hdf5) {
+    data = (sandbox.root / "recording.h5").string();
+    ASSERT_EQ(RunEvfs("convert --data=" + sandbox.data + " --out=" + data).exit_code, 0);
+  }
+  const fs::path out = sandbox.root / "out";
+  const std::vector<std::string> arguments = {"reconstruct", "--data=" + data,
+                                              "--mode=interpolate", "--first=0", "--last=1",
+                                              "--out=" + out.string()};
+  const CommandResult earlier = sandbox.Run(sandbox.Reconstruct(out));
+  ASSERT_EQ(earlier.exit_code, 0) << earlier.output;
+  const std::string earlier_summary = ReadFile((out / "summary.json").string());
+
+  std::vector<std::string> long_job = arguments;
+  long_job.push_back("--fps=1000000");
+  long_job.push_back("--overwrite");
+  const pid_t pid = StartEvfs(long_job, sandbox.root);
+  ASSERT_GT(pid, 0);
+  const fs::path staging = WaitForStagedFrame(out, "000100.png", std::chrono::seconds(60));
+  ASSERT_FALSE(staging.empty()) << "evfs never wrote frames";
+  ASSERT_EQ(kill(pid, signal_number), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  const std::string errors = ReadFile((sandbox.root / "stderr.txt").string());
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit status " << WEXITSTATUS(status) << ": " << errors;
+  EXPECT_EQ(WTERMSIG(status), signal_number);
+  EXPECT_NE(errors.find("the unfinished output was removed"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(staging)) << staging;
+  ExpectNoStagingLeft(out);
+  EXPECT_EQ(ReadFile((out / "summary.json").string()), earlier_summary);
+  EXPECT_FALSE(fs::exists(out / "frames/000100.png")) << "new frames mixed into the old output";
+  sandbox.ExpectUntouched();
+}
+
+TEST(EvfsOutput, SigintWhileWritingFramesKeepsTheEarlierOutput) {
+  ExpectSignalLeavesTheEarlierOutput(SIGINT, false);
+}
+
+TEST(EvfsOutput, SigtermWhileWritingFramesKeepsTheEarlierOutput) {
+  ExpectSignalLeavesTheEarlierOutput(SIGTERM, false);
+}
+
+TEST(EvfsOutput, SighupWhileWritingFramesKeepsTheEarlierOutput) {
+  ExpectSignalLeavesTheEarlierOutput(SIGHUP, false);
+}
+
+TEST(EvfsOutput, SigtermWhileWritingFramesFromHdf5KeepsTheEarlierOutput) {
+  ExpectSignalLeavesTheEarlierOutput(SIGTERM, true);
+}
+
+}  // namespace
+}  // namespace evfs
