@@ -9,8 +9,8 @@
 #include "baselines/scalar_search.h"
 #include "core/error.h"
 #include "core/metrics.h"
-#include "solver/event_model_estimation.h"
-#include "solver/problem_builder.h"
+#include "scene/event_model_estimation.h"
+#include "scene/scene.h"
 
 namespace evfs {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "solver/event_model_estimation.h"
+#include "scene/event_model_estimation.h"
 
 namespace evfs {
 

@@ -29,7 +29,7 @@
 
 #include "baselines/baseline_options.h"
 #include "core/video.h"
-#include "solver/scene.h"
+#include "scene/scene.h"
 
 namespace evfs {
 

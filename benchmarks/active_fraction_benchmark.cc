@@ -19,7 +19,7 @@
 #include "core/metrics.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
-#include "examples/allocator_tuning.h"
+#include "app/allocator_tuning.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(fractions, "0,0.05,0.1,0.25,0.5,0.75,1",

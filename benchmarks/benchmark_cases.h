@@ -9,7 +9,7 @@
 
 #include "core/event_stream.h"
 #include "core/video.h"
-#include "solver/scene.h"
+#include "scene/scene.h"
 
 namespace evfs {
 

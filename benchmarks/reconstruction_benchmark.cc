@@ -23,8 +23,8 @@
 #include "core/metrics.h"
 #include "core/time.h"
 #include "events/simulator.h"
-#include "examples/allocator_tuning.h"
-#include "examples/reconstruct_job.h"
+#include "app/allocator_tuning.h"
+#include "app/reconstruct_job.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
@@ -56,6 +56,8 @@ DEFINE_int32(max_iterations, evfs::ReconstructionOptions().solver.max_num_iterat
              "most Levenberg-Marquardt iterations.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "auto binning's voxel budget.");
+DEFINE_double(hot_pixel_factor, evfs::BinningOptions().hot_pixel_factor,
+              "hot pixel rule of the binning (0: keep every event).");
 
 namespace evfs {
 namespace {
@@ -99,6 +101,7 @@ ReconstructionOptions Options() {
 BinningOptions Binning() {
   BinningOptions binning;
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
+  binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
   return binning;
 }
 

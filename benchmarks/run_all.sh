@@ -24,6 +24,14 @@ if [ -d "$data" ]; then
   echo
   echo "== every method on every case, one process per cell (method_benchmark)"
   "$build/benchmarks/method_benchmark" --data="$data" --out="$build/bench"
+  echo
+  echo "== PSNR against time per case, from method_benchmark's CSV files (plot_methods.py)"
+  # Debian's python3-matplotlib is /usr/bin/python3's; another python3 may come first on PATH.
+  if /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
+    /usr/bin/python3 benchmarks/plot_methods.py "$build/bench"
+  else
+    echo "no python3-matplotlib (scripts/install-deps.sh installs it): skipping the plots"
+  fi
 else
   echo "no shared data folder at $data: skipping the real-data runs"
 fi

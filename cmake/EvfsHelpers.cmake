@@ -1,30 +1,79 @@
+include("${CMAKE_CURRENT_LIST_DIR}/EvfsLayers.cmake")
+evfs_read_layers("${PROJECT_SOURCE_DIR}/cmake/layers.txt" EVFS_MODULES)
+
+# evfs_module_include_dir(MODULE OUT_VAR)
+#   The include directory of a module: a folder in the build tree holding links to the module's
+#   own folder and to the folders cmake/layers.txt lets it use, and nothing else. So code still
+#   includes "core/video.h", but a module that includes a header above its layer does not build.
+function(evfs_module_include_dir module out_var)
+  if(NOT module IN_LIST EVFS_MODULES)
+    message(FATAL_ERROR "${module} is not a module of cmake/layers.txt")
+  endif()
+  set(dir "${PROJECT_BINARY_DIR}/include/${module}")
+  foreach(used IN LISTS module EVFS_LAYER_${module})
+    if(NOT IS_SYMLINK "${dir}/${used}")
+      file(MAKE_DIRECTORY "${dir}")
+      file(CREATE_LINK "${PROJECT_SOURCE_DIR}/${used}" "${dir}/${used}" SYMBOLIC)
+    endif()
+  endforeach()
+  set(${out_var} "${dir}" PARENT_SCOPE)
+endfunction()
+
+# The module a CMakeLists.txt belongs to: the first folder of its path in the repository.
+function(evfs_current_module out_var)
+  file(RELATIVE_PATH relative "${PROJECT_SOURCE_DIR}" "${CMAKE_CURRENT_SOURCE_DIR}")
+  string(REGEX REPLACE "/.*" "" module "${relative}")
+  set(${out_var} "${module}" PARENT_SCOPE)
+endfunction()
+
 # evfs_add_library(NAME SRCS a.cc ... DEPS lib ...)
-#   One static library per module folder; the repository root is the include root, so code
-#   includes "core/video.h", "io/event_reader.h", ...
+#   One static library per module folder (INTERFACE when SRCS holds no source), seeing only the
+#   modules it may use (evfs_module_include_dir).
 function(evfs_add_library name)
   cmake_parse_arguments(ARG "" "" "SRCS;DEPS" ${ARGN})
-  add_library(${name} STATIC ${ARG_SRCS})
-  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
-  target_link_libraries(${name} PUBLIC ${ARG_DEPS})
+  evfs_current_module(module)
+  evfs_module_include_dir(${module} include_dir)
+  if(ARG_SRCS)
+    add_library(${name} STATIC ${ARG_SRCS})
+    target_include_directories(${name} PUBLIC "${include_dir}")
+    target_link_libraries(${name} PUBLIC ${ARG_DEPS})
+  else()
+    add_library(${name} INTERFACE)
+    target_include_directories(${name} INTERFACE "${include_dir}")
+    target_link_libraries(${name} INTERFACE ${ARG_DEPS})
+  endif()
+endfunction()
+
+# evfs_add_executable(NAME SRCS a.cc ... LINK_LIBS lib ...)
+#   A program of a module (the CLI, a benchmark, a tool), seeing only the modules it may use.
+function(evfs_add_executable name)
+  cmake_parse_arguments(ARG "" "" "SRCS;LINK_LIBS" ${ARGN})
+  evfs_current_module(module)
+  evfs_module_include_dir(${module} include_dir)
+  add_executable(${name} ${ARG_SRCS})
+  target_include_directories(${name} PRIVATE "${include_dir}")
+  target_link_libraries(${name} PRIVATE ${ARG_LINK_LIBS})
 endfunction()
 
 # evfs_add_test(NAME SRCS a_test.cc ... LINK_LIBS lib ...)
-#   Adds a GoogleTest executable and registers it with CTest. EVFS_DATA_DIR is compiled in
-#   so that tests reading the shared snippets can find them (or skip when it is empty).
+#   Adds a GoogleTest executable and registers each of its tests with CTest. EVFS_DATA_DIR is
+#   compiled in so that tests reading the shared snippets can find them (or skip when it is empty).
 function(evfs_add_test name)
   cmake_parse_arguments(ARG "" "" "SRCS;LINK_LIBS" ${ARGN})
   add_executable(${name} ${ARG_SRCS})
+  # Tests may use every module, and their own helpers under tests/.
+  target_include_directories(${name} PRIVATE "${PROJECT_SOURCE_DIR}")
   target_link_libraries(${name} PRIVATE ${ARG_LINK_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE EVFS_DATA_DIR="${EVFS_DATA_DIR}"
                              EVFS_TEST_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
                              EVFS_TEST_TMP_DIR="${CMAKE_CURRENT_BINARY_DIR}/tmp_${name}")
-  add_test(NAME ${name} COMMAND ${name})
+  # One ctest entry per test case, listed when ctest runs (so a build never runs a binary).
+  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 NO_PRETTY_VALUES)
 endfunction()
 
 # evfs_add_benchmark(NAME SRCS a.cc ... LINK_LIBS lib ...)
 function(evfs_add_benchmark name)
   cmake_parse_arguments(ARG "" "" "SRCS;LINK_LIBS" ${ARGN})
-  add_executable(${name} ${ARG_SRCS})
-  target_link_libraries(${name} PRIVATE ${ARG_LINK_LIBS})
+  evfs_add_executable(${name} SRCS ${ARG_SRCS} LINK_LIBS ${ARG_LINK_LIBS})
   target_compile_definitions(${name} PRIVATE EVFS_DATA_DIR="${EVFS_DATA_DIR}")
 endfunction()

@@ -1,6 +1,6 @@
-// Typed errors for everything that is the user's fault: a bad file, a bad flag value, bad data.
-// CHECK is kept for programmer errors; these exceptions are caught by the CLI and turned into
-// one readable line and exit code 2.
+// Typed errors for everything that is the user's fault: a bad file, a bad flag value, bad data;
+// and for a solver that fails on valid input. CHECK is kept for programmer errors. The CLI turns
+// each into one readable line and an exit status that says whose the failure is (ExitStatus).
 #ifndef EVFS_CORE_ERROR_H_
 #define EVFS_CORE_ERROR_H_
 
@@ -10,10 +10,35 @@
 
 namespace evfs {
 
+/// Exit statuses of the evfs command-line tool, by whose failure it is.
+enum ExitStatus : int {
+  kExitSuccess = 0,
+  /// An exception evfs did not anticipate (out of memory, a file-system error): one line.
+  kExitUnexpected = 1,
+  /// The user's error: a bad flag, file, value or output path (InputError,
+  /// InvalidArgumentError, a flag gflags cannot parse). One line naming what is wrong.
+  kExitUserError = 2,
+  /// A bug in evfs: a failed CHECK (or LOG(FATAL)), or a crash outside libhdf5. One line
+  /// "internal error: ... please report" naming the check or the signal.
+  kExitInternalError = 3,
+  /// The solver failed on input that was accepted (SolverError): neither the user's fault nor
+  /// a bug in evfs' own code, and the input may well solve with other settings.
+  kExitSolverFailure = 4,
+  // 128 + N: stopped by signal N (SIGINT, SIGTERM, SIGHUP), the unfinished output removed.
+};
+
 /// Base class of every error evfs reports to a user.
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& message) : std::runtime_error(message) {}
+};
+
+/// The solver failed on a problem built from valid input: Ceres ended with FAILURE (a
+/// non-finite cost or Jacobian, a linear solver that broke down). Reported with exit status
+/// kExitSolverFailure, not as the user's error.
+class SolverError : public Error {
+ public:
+  explicit SolverError(const std::string& message) : Error(message) {}
 };
 
 /// A value given by the user (an option, a flag, an index) is outside what is accepted.

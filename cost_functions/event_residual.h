@@ -13,7 +13,7 @@
 #include <ceres/sized_cost_function.h>
 #include <glog/logging.h>
 
-#include "cost_functions/event_model.h"
+#include "scene/event_model.h"
 #include "cost_functions/scalar_parameter_blocks.h"
 
 namespace evfs {

@@ -1,6 +1,7 @@
 #include "events/binning.h"
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -81,6 +82,84 @@ int PixelIndex(const EventStream& events, size_t i) {
 
 }  // namespace
 
+int64_t CountCollisionFrames(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns) {
+  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "CountCollisionFrames");
+  if (range.first == range.last) return 0;
+  // The walk of BinByCollision without the frames: last_fired[p] is the last frame pixel p fired
+  // in (-1: none yet).
+  std::vector<int32_t> last_fired(static_cast<size_t>(events.width()) * events.height(), -1);
+  int32_t current = -1;
+  for (size_t i = range.first; i < range.last; ++i) {
+    const int pixel = PixelIndex(events, i);
+    if (current < 0 || last_fired[pixel] == current) {
+      if (current == std::numeric_limits<int32_t>::max() - 1) {
+        throw InvalidArgumentError("CountCollisionFrames: more than 2^31 collision frames");
+      }
+      ++current;
+    }
+    last_fired[pixel] = current;
+  }
+  return static_cast<int64_t>(current) + 1;
+}
+
+PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns,
+                                   int64_t t_end_ns, double hot_pixel_factor) {
+  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "MeasurePixelActivity");
+  PixelActivity activity;
+  activity.num_events = static_cast<int64_t>(range.last - range.first);
+  if (range.first == range.last) return activity;
+  std::vector<int32_t> counts(static_cast<size_t>(events.width()) * events.height(), 0);
+  for (size_t i = range.first; i < range.last; ++i) {
+    int32_t& count = counts[PixelIndex(events, i)];
+    count += count < std::numeric_limits<int32_t>::max();  // saturates: only compared
+  }
+  std::vector<int32_t> fired_counts;
+  for (const int32_t count : counts) {
+    if (count > 0) fired_counts.push_back(count);
+  }
+  activity.pixels_fired = static_cast<int64_t>(fired_counts.size());
+  activity.busiest_count = *std::max_element(fired_counts.begin(), fired_counts.end());
+  // The reference is the pixel of rank ceil(n / 100) from the busiest (rank 0), at least rank 1.
+  const size_t rank = std::max<size_t>(1, (fired_counts.size() + 99) / 100);
+  if (rank >= fired_counts.size()) return activity;  // one pixel fired: nothing to compare with
+  std::nth_element(fired_counts.begin(), fired_counts.begin() + rank, fired_counts.end(),
+                   std::greater<int32_t>());
+  activity.reference_count = fired_counts[rank];
+  if (!(hot_pixel_factor > 0.0)) return activity;
+  const double hot_above = hot_pixel_factor * static_cast<double>(activity.reference_count);
+  for (size_t p = 0; p < counts.size(); ++p) {
+    if (static_cast<double>(counts[p]) > hot_above) {
+      activity.hot_pixels.push_back(static_cast<int32_t>(p));
+      activity.hot_pixel_events += counts[p];
+    }
+  }
+  return activity;
+}
+
+EventStream WithoutPixels(const EventStream& events, const std::vector<int32_t>& pixels) {
+  EventStream kept(events.width(), events.height());
+  if (pixels.empty()) {
+    kept = events;
+    return kept;
+  }
+  std::vector<uint8_t> dropped(static_cast<size_t>(events.width()) * events.height(), 0);
+  for (const int32_t pixel : pixels) dropped.at(static_cast<size_t>(pixel)) = 1;
+  // Events off the sensor are kept, for the binning to reject.
+  const auto keep = [&](size_t i) {
+    return events.x(i) >= events.width() || events.y(i) >= events.height() ||
+           !dropped[PixelIndex(events, i)];
+  };
+  size_t count = 0;
+  for (size_t i = 0; i < events.size(); ++i) count += keep(i);
+  kept.reserve(count);
+  for (size_t i = 0; i < events.size(); ++i) {
+    if (keep(i)) {
+      kept.push_back(events.t_ns(i), events.x(i), events.y(i), events.polarity(i));
+    }
+  }
+  return kept;
+}
+
 EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns) {
   const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "BinByCollision");
   EventFrames frames(events.height(), events.width());
@@ -122,6 +201,9 @@ bool StackedBinningOptions::IsValid(std::string* error) const {
   OptionChecker check;
   check.InRange("num_frames", num_frames, 1, std::numeric_limits<int>::max())
       .InRange("steps_per_frame", steps_per_frame, 1, std::numeric_limits<int>::max())
+      .InRange("num_frames * steps_per_frame",
+               static_cast<long long>(num_frames) * steps_per_frame, 1,
+               std::numeric_limits<int>::max() - 1)
       .Require(split == Split::kEqualTime || split == Split::kEqualCount, "split",
                "kEqualTime or kEqualCount");
   return check.Passed(error);
@@ -136,6 +218,12 @@ EventFrames BinStacked(const EventStream& events, int64_t t_begin_ns, int64_t t_
   const int steps = options.steps_per_frame;
   const int64_t duration_ns = t_end_ns - t_begin_ns;
   const int64_t num_events = static_cast<int64_t>(range.last - range.first);
+  // Checked before the boundaries are allocated; MakeStrictlyIncreasing checks it again.
+  if (duration_ns < static_cast<int64_t>(num_frames) * steps) {
+    throw InvalidArgumentError("BinStacked: a window of " + std::to_string(duration_ns) +
+                               " ns cannot hold " + std::to_string(num_frames) + " frames of " +
+                               std::to_string(steps) + " latent steps of 1 ns or more");
+  }
 
   std::vector<int64_t> boundaries_ns(num_frames + 1);
   boundaries_ns.front() = t_begin_ns;

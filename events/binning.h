@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/event_frames.h"
 #include "core/event_stream.h"
@@ -32,6 +33,40 @@ namespace evfs {
 /// possible when one pixel fires repeatedly at the same timestamp).
 EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns);
 
+/// The number of event frames BinByCollision(events, t_begin_ns, t_end_ns) gives, counted
+/// without allocating a frame (O(events) time, one int32 per pixel), so that a caller can decide
+/// the binning, and so its memory (frames × pixels values), before allocating anything. Throws
+/// as BinByCollision does for a bad window or bad events.
+int64_t CountCollisionFrames(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns);
+
+/// How the pixels of a window fired, and which of them are hot.
+///
+/// A hot pixel is a sensor defect that fires on its own, often at kHz, while the scene around it
+/// is quiet. Collision binning opens a frame at every repeat of a pixel, so one hot pixel firing
+/// N times would turn the window into N latent steps of the whole sensor (N × pixels unknowns)
+/// for events that record no change of the scene.
+struct PixelActivity {
+  int64_t num_events = 0;           // events in the window
+  int64_t pixels_fired = 0;         // pixels with at least one event
+  int64_t busiest_count = 0;        // events of the busiest pixel
+  int64_t reference_count = 0;      // events of the reference pixel (see MeasurePixelActivity)
+  std::vector<int32_t> hot_pixels;  // row-major indices (y · width + x) of hot pixels, ascending
+  int64_t hot_pixel_events = 0;     // events at the hot pixels
+};
+
+/// Counts the events of every pixel in [t_begin_ns, t_end_ns) and finds the hot pixels: those
+/// with more than `hot_pixel_factor` times the events of the reference pixel, the busiest pixel
+/// outside the busiest 1 % of the pixels that fired (the second busiest when at most 100
+/// fired). Up to 1 % of the firing pixels can thus be hot without hiding one another, and with
+/// a single pixel firing nothing is hot: there is no scene to compare it with.
+/// hot_pixel_factor <= 0 finds none. O(events + pixels) time, one int32 per pixel. Throws as
+/// BinByCollision does for a bad window or bad events.
+PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns,
+                                   int64_t t_end_ns, double hot_pixel_factor);
+
+/// The events of `events` except those at `pixels` (row-major indices, ascending); same sensor.
+EventStream WithoutPixels(const EventStream& events, const std::vector<int32_t>& pixels);
+
 /// Options of the paper's Binning 2 (stacking).
 struct StackedBinningOptions {
   /// How the window is split into frames.
@@ -42,7 +77,7 @@ struct StackedBinningOptions {
 
   int num_frames = 8;               // event frames M over the window, >= 1
   Split split = Split::kEqualTime;  // how frame boundaries are placed
-  int steps_per_frame = 1;          // latent steps S each frame spans, >= 1
+  int steps_per_frame = 1;          // latent steps S each frame spans, >= 1, M · S < 2^31 - 1
 
   /// False (with a reason in `error`, which may be null) when a field is out of range.
   bool IsValid(std::string* error) const;
@@ -61,7 +96,8 @@ struct StackedBinningOptions {
 ///
 /// Each span records its first and last event time and event count (an empty frame records its
 /// start boundary as both times). Throws InvalidArgumentError for invalid options, an empty or
-/// reversed window, a window shorter than M·S ns, unsorted events or events off the sensor.
+/// reversed window, a window shorter than M·S ns (before allocating anything), unsorted events
+/// or events off the sensor.
 EventFrames BinStacked(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
                        const StackedBinningOptions& options);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "core/error.h"
@@ -34,6 +35,24 @@ std::vector<double> DrawThresholds(double nominal, double sigma, size_t count, R
   return thresholds;
 }
 
+/// Expected background noise events of `num_pixels` pixels over `interval_ns`, in double: the
+/// product overflows int64 for absurd rates, and it is only compared.
+double ExpectedNoiseEvents(const SimulatorOptions& options, double num_pixels,
+                           double interval_ns) {
+  return options.noise_rate_hz * num_pixels * interval_ns / kNanosecondsPerSecond;
+}
+
+/// Throws when `expected` events exceed options.max_events; `what` says over what.
+void CheckEventBudget(const SimulatorOptions& options, double expected, const std::string& what) {
+  if (expected > static_cast<double>(options.max_events)) {
+    char count[32];
+    std::snprintf(count, sizeof(count), "%.3g", expected);
+    throw InvalidArgumentError("simulator: " + what + " " + count +
+                               " events, more than max_events = " +
+                               std::to_string(options.max_events));
+  }
+}
+
 }  // namespace
 
 bool SimulatorOptions::IsValid(std::string* error) const {
@@ -43,7 +62,8 @@ bool SimulatorOptions::IsValid(std::string* error) const {
       .NonNegative("threshold_sigma", threshold_sigma)
       .Require(refractory_period_ns >= 0, "refractory_period_ns", ">= 0")
       .NonNegative("noise_rate_hz", noise_rate_hz)
-      .Positive("log_eps", log_eps);
+      .Positive("log_eps", log_eps)
+      .Require(max_events > 0, "max_events", "> 0");
   return check.Passed(error);
 }
 
@@ -124,11 +144,23 @@ void EventSimulator::AddNoiseEvents(int64_t t_ns, std::vector<PendingEvent>* out
   // Independent Poisson processes per pixel are one Poisson process over the sensor at the
   // summed rate whose events land on uniformly drawn pixels.
   const uint64_t num_pixels = log_intensity_.size();
+  // Checked before drawing: at an absurd rate the loop below would fill memory.
+  CheckEventBudget(options_,
+                   static_cast<double>(out->size()) +
+                       ExpectedNoiseEvents(options_, static_cast<double>(num_pixels),
+                                           static_cast<double>(t_ns - t_ns_)),
+                   "noise_rate_hz = " + std::to_string(options_.noise_rate_hz) +
+                       " between two frames gives about");
   const double rate_per_ns =
       options_.noise_rate_hz * static_cast<double>(num_pixels) / kNanosecondsPerSecond;
   const double interval_ns = static_cast<double>(t_ns - t_ns_);
   for (double elapsed_ns = noise_random_.Exponential(rate_per_ns); elapsed_ns <= interval_ns;
        elapsed_ns += noise_random_.Exponential(rate_per_ns)) {
+    // A Poisson draw can exceed its mean; the budget holds for the events actually drawn too.
+    if (static_cast<int64_t>(out->size()) >= options_.max_events) {
+      CheckEventBudget(options_, static_cast<double>(out->size()) + 1.0,
+                       "the noise between two frames makes");
+    }
     const int64_t offset_ns = std::clamp<int64_t>(std::llround(elapsed_ns), 1, t_ns - t_ns_);
     const int32_t pixel = static_cast<int32_t>(noise_random_.UniformIndex(num_pixels));
     out->push_back({t_ns_ + offset_ns, pixel, noise_random_.Sign()});
@@ -167,10 +199,20 @@ EventStream EventSimulator::Advance(const Image& next_frame, int64_t t_ns) {
 EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options) {
   if (frames.empty()) throw InvalidArgumentError("SimulateEvents: the video has no frames");
   EventSimulator simulator(frames.height(), frames.width(), options);
+  // The whole video's noise, checked before simulating anything.
+  const double num_pixels = static_cast<double>(frames.width()) * frames.height();
+  const double duration_ns = static_cast<double>(frames.timestamp_ns(frames.num_frames() - 1)) -
+                             static_cast<double>(frames.timestamp_ns(0));
+  CheckEventBudget(options, ExpectedNoiseEvents(options, num_pixels, duration_ns),
+                   "noise_rate_hz = " + std::to_string(options.noise_rate_hz) + " over " +
+                       std::to_string(frames.width()) + "x" + std::to_string(frames.height()) +
+                       " pixels and " + std::to_string(duration_ns / kNanosecondsPerSecond) +
+                       " s gives about");
   simulator.Reset(frames.frame(0), frames.timestamp_ns(0));
   EventStream events(frames.width(), frames.height());
   for (int t = 1; t < frames.num_frames(); ++t) {
     events.Append(simulator.Advance(frames.frame(t), frames.timestamp_ns(t)));
+    CheckEventBudget(options, static_cast<double>(events.size()), "the video makes");
   }
   return events;
 }

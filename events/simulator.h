@@ -33,6 +33,10 @@ struct SimulatorOptions {
   double noise_rate_hz = 0.0;           // background events per pixel per second (random sign)
   double log_eps = 1e-3;                // offset b of L = log(I + b), > 0
   uint64_t seed = 42;                   // seeds the thresholds and the noise
+  /// Most events one Advance (and SimulateEvents in all) may produce, > 0: about 30 bytes each
+  /// while simulating, so the default bounds memory near 3 GB. Background noise beyond it is
+  /// refused before it is drawn (noise_rate_hz × pixels × seconds is known in advance).
+  int64_t max_events = 100000000;
 
   /// False (with a reason in `error`, which may be null) when a field is out of range.
   bool IsValid(std::string* error) const;
@@ -62,7 +66,8 @@ class EventSimulator {
   /// The events between the previous frame and `next_frame`, with timestamps in
   /// (previous t_ns, t_ns], sorted by time (ties by pixel index, then in order of generation),
   /// sensor size set. Throws InvalidArgumentError before Reset, for a frame of another size,
-  /// a negative or non-finite intensity, or t_ns not after the previous frame.
+  /// a negative or non-finite intensity, t_ns not after the previous frame, or more than
+  /// options.max_events events (expected noise events checked before drawing any).
   EventStream Advance(const Image& next_frame, int64_t t_ns);
 
   int height() const { return height_; }
@@ -97,7 +102,9 @@ class EventSimulator {
 };
 
 /// Simulates the events of a whole video (frame 0 starts the sensor); the stream's sensor size
-/// is the video's. Throws InvalidArgumentError for an empty video or as EventSimulator does.
+/// is the video's. Throws InvalidArgumentError for an empty video, when the expected noise
+/// events over the whole video or the events produced exceed options.max_events, or as
+/// EventSimulator does.
 EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options);
 
 }  // namespace evfs

@@ -4,15 +4,17 @@
 //   evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]
 //                    [--truth=K] --out=OUT [solver and model flags]
 //   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
-//   evfs convert     --data=DIR|FILE.h5 --out=FILE.h5|DIR
+//   evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR
 //   evfs demo        --out=DIR
 //
 // Flags are read here and nowhere else; every failure that is the user's (a bad file, a bad
 // flag) prints one line and exits with status 2.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -25,26 +27,30 @@
 #include "core/time.h"
 #include "events/binning.h"
 #include "events/simulator.h"
-#include "examples/allocator_tuning.h"
-#include "examples/crash_guard.h"
-#include "examples/demo.h"
-#include "examples/reconstruct_job.h"
+#include "app/allocator_tuning.h"
+#include "app/crash_guard.h"
+#include "app/demo.h"
+#include "app/progress.h"
+#include "app/reconstruct_job.h"
+#include "io/aedat4.h"
 #include "io/data_source.h"
 #include "io/frame_list.h"
 #include "io/hdf5_io.h"
 #include "io/image_io.h"
 #include "io/output_target.h"
 #include "io/text_folder.h"
-#include "solver/activity_mask.h"
+#include "scene/scene.h"
 
 // Input and output.
-DEFINE_string(data, "", "Data folder (Event Camera Dataset layout) or HDF5 event file.");
+DEFINE_string(data, "", "Data folder (Event Camera Dataset layout), HDF5 event file or AEDAT 4 "
+              "recording (.aedat4, from iniVation DV).");
 DEFINE_string(frames, "", "simulate: folder with images.txt ('t path' lines) and the frames.");
-DEFINE_string(out, "", "Output folder (reconstruct, simulate, demo) or file (convert to .h5): "
+DEFINE_string(out, "", "Output folder (reconstruct, simulate, demo) or file (convert to .h5 or .aedat4): "
               "a new one, or an earlier output of the same command with --overwrite. Never "
               "the root, current or home folder, nor the input or a folder around it.");
 DEFINE_bool(overwrite, false, "Replace --out when it holds an earlier output of the same command "
-            "(marked by OUT/.evfs-output, or an .h5 file evfs wrote); nothing else is replaced.");
+            "(marked by OUT/.evfs-output, or an .h5/.aedat4 file evfs wrote); nothing else is "
+            "replaced.");
 // Which frames.
 DEFINE_int32(first, -1, "0-based images.txt line of the first (or blurred) frame.");
 DEFINE_int32(last, -1,
@@ -75,12 +81,18 @@ DEFINE_double(cf_cutoff_rad_per_s, evfs::BaselineOptions().cutoff_rad_per_s,
               "cf: crossover frequency of the complementary filter.");
 // Binning.
 DEFINE_string(binning, "auto", "auto | collision | stacked. auto: collision binning (the "
-              "paper's), unless it gives more than --max_latent_frames frames.");
+              "paper's), unless it gives more than --max_latent_frames frames or "
+              "--max_latent_voxels voxels; collision or stacked beyond --max_latent_voxels is "
+              "refused.");
 DEFINE_int32(max_latent_frames, evfs::BinningOptions().max_latent_frames, "auto binning: most latent steps before switching to "
              "stacked equal-time binning with this many frames.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
-             "auto binning: most pixels x latent frames (at least 4 steps are kept); bounds "
-             "memory and time on large sensors.");
+             "Most pixels x latent frames, decided from event counts before anything is "
+             "allocated; bounds memory and time (auto binning takes as many steps as fit).");
+DEFINE_double(hot_pixel_factor, evfs::BinningOptions().hot_pixel_factor,
+              "Leave out the events of hot pixels: those firing more than this many times as "
+              "often as the window's busy pixels (the busiest outside the top 1 %); 0 keeps "
+              "every event.");
 DEFINE_int32(stacked_frames, evfs::BinningOptions().stacked.num_frames, "stacked binning: number of event frames.");
 // Objective.
 DEFINE_double(frame_weight, evfs::ObjectiveOptions().frame_weight, "Weight of the frame term.");
@@ -124,7 +136,10 @@ DEFINE_int32(bounds_line_search_iterations,
              "(0: none; the step is only projected onto the bounds).");
 DEFINE_double(function_tolerance, evfs::DefaultSolverOptions().function_tolerance, "Stop when the relative cost change falls below this.");
 DEFINE_int32(threads, evfs::DefaultSolverOptions().num_threads, "Threads for Jacobian evaluation and the linear solver.");
-DEFINE_bool(progress, false, "Print a line per iteration even when stderr is not a terminal.");
+DEFINE_bool(progress, false, "Print a line per solver iteration even when stderr is not a "
+            "terminal (it slows a solve split into independent parts).");
+DEFINE_double(progress_interval_s, 5.0, "While a command runs, a line on stderr (stage, "
+              "iteration, elapsed time) every this many seconds, terminal or not; 0: none.");
 // Simulator.
 DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos, "simulate: ON contrast threshold (log intensity).");
 DEFINE_double(threshold_neg, evfs::SimulatorOptions().contrast_threshold_neg, "simulate: OFF contrast threshold (log intensity).");
@@ -144,10 +159,11 @@ constexpr char kUsage[] =
     "                   [--truth=K] --out=OUT [--fps=N] [solver and model flags]\n"
     "  evfs simulate    --frames=DIR --out=DIR [--threshold_pos=0.2 --threshold_neg=0.2 "
     "--seed=42]\n"
-    "  evfs convert     --data=DIR|FILE.h5 --out=FILE.h5|DIR\n"
+    "  evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR\n"
     "  evfs demo        --out=DIR\n\n"
     "DIR is a folder in the Event Camera Dataset layout (events.txt 't x y p', images.txt\n"
-    "'t path', images/, optional exposures.txt 'path t_start t_end') or an .h5 file.\n"
+    "'t path', images/, optional exposures.txt 'path t_start t_end'), an .h5 file or an\n"
+    ".aedat4 recording (iniVation DV: events and frames).\n"
     "I, J, K are 0-based lines of images.txt. Example:\n"
     "  evfs reconstruct --data=../shared/data/slider_depth_70_71 --mode=predict --first=0 "
     "--last=1 --truth=1 --out=out/slider\n"
@@ -167,21 +183,52 @@ OutputOptions OutputFromFlags(const std::string& command, const std::string& inp
   return options;
 }
 
+// The binning flags (reconstruct, and info's window).
+BinningOptions BinningFromFlags() {
+  BinningOptions binning;
+  if (FLAGS_binning == "auto") {
+    binning.method = BinningOptions::Method::kAuto;
+  } else if (FLAGS_binning == "collision") {
+    binning.method = BinningOptions::Method::kCollision;
+  } else if (FLAGS_binning == "stacked") {
+    binning.method = BinningOptions::Method::kStacked;
+  } else {
+    throw InvalidArgumentError("--binning must be auto, collision or stacked");
+  }
+  binning.max_latent_frames = FLAGS_max_latent_frames;
+  binning.max_latent_voxels = FLAGS_max_latent_voxels;
+  binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
+  binning.stacked.num_frames = FLAGS_stacked_frames;
+  return binning;
+}
+
 // The events between frames `first` and `last` (counts, polarities, the pixels that fired, the
-// collision frames) and the frames' change of mean brightness.
+// collision frames, hot pixels), the binning a reconstruction would get with the same flags
+// (decided from counts: no frame is allocated), and the frames' change of mean brightness.
 void PrintWindow(const DataSource& source, int first, int last) {
   const int64_t begin_ns = source.frames()[first].t_ns, end_ns = source.frames()[last].t_ns;
   const EventStream window = source.ReadEvents(begin_ns, end_ns);
-  const EventFrames collision = BinByCollision(window, begin_ns, end_ns);
+  const BinningPlan plan = PlanBinning(window, begin_ns, end_ns, BinningFromFlags());
+  const PixelActivity& activity = plan.activity;
   const size_t positive = window.CountPositive();
-  const ActivityMask fired(collision, /*radius_px=*/0);
+  std::string hot;
+  if (!activity.hot_pixels.empty()) {
+    hot = " without " + std::to_string(activity.hot_pixels.size()) + " hot pixel" +
+          (activity.hot_pixels.size() == 1 ? "" : "s") + " (" +
+          std::to_string(activity.hot_pixel_events) + " events left out)";
+  }
   std::printf("window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %lld pixels "
-              "(%.1f %%), %d collision frames\n",
+              "(%.1f %%), %lld collision frames%s\n",
               first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(), positive,
-              window.size() - positive, static_cast<long long>(fired.num_active()),
-              100.0 * static_cast<double>(fired.num_active()) /
-                  static_cast<double>(fired.num_pixels()),
-              collision.num_frames());
+              window.size() - positive, static_cast<long long>(activity.pixels_fired),
+              100.0 * static_cast<double>(activity.pixels_fired) /
+                  static_cast<double>(plan.pixels),
+              static_cast<long long>(plan.collision_frames), hot.c_str());
+  const bool collision = plan.method == BinningOptions::Method::kCollision;
+  std::printf("binning     %s: %s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
+              FLAGS_binning.c_str(), collision ? "collision" : "stacked", plan.num_event_frames,
+              plan.num_latent_frames, static_cast<long long>(plan.latent_voxels()),
+              static_cast<long long>(FLAGS_max_latent_voxels));
   // A change of overall brightness between the frames (flicker, exposure or gain) that no
   // event records is outside the per-pixel event model; this line shows it.
   const double first_mean = source.ReadImage(first).mean();
@@ -211,7 +258,11 @@ int RunInfo() {
     if (span_s > 0) std::printf("event rate  %.3f Mev/s\n", events.count / span_s / 1e6);
   }
   const auto& frames = source->frames();
-  std::printf("frames      %zu\n", frames.size());
+  if (frames.empty()) {
+    std::printf("frames      0 (%s)\n", source->no_frames_reason().c_str());
+  } else {
+    std::printf("frames      %zu\n", frames.size());
+  }
   for (size_t i = 0; i < frames.size(); ++i) {
     std::printf("  %3zu  t=%.6f s  %s", i, NanosecondsToSeconds(frames[i].t_ns),
                 frames[i].path.c_str());
@@ -227,6 +278,8 @@ int RunInfo() {
   if (FLAGS_first >= 0 && source->has_events()) {
     const int count = static_cast<int>(frames.size());
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
+    Require(count > 0, source->path() + " has 0 frames (" + source->no_frames_reason() +
+                           "): --first/--last name frames");
     Require(FLAGS_first < count && last < count && last > FLAGS_first,
             "--first/--last must be frame indices with first < last < " + std::to_string(count));
     PrintWindow(*source, FLAGS_first, last);
@@ -240,6 +293,9 @@ int RunConvert() {
   if (IsHdf5Path(FLAGS_out)) {
     options.kind = OutputOptions::Kind::kFile;
     options.is_own_file = IsHdf5WrittenByEvfs;
+  } else if (IsAedat4Path(FLAGS_out)) {
+    options.kind = OutputOptions::Kind::kFile;
+    options.is_own_file = IsAedat4WrittenByEvfs;
   }
   OutputTarget out(options);
   ConvertRecording(FLAGS_data, out.staging());
@@ -305,13 +361,6 @@ std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
   return numbers;
 }
 
-// One progress line per iteration of an iterative solver.
-bool PrintProgress(const SolverIteration& iteration) {
-  std::fprintf(stderr, "iter %4d  cost %.6e  %.2f s\n", iteration.iteration, iteration.cost,
-               iteration.elapsed_s);
-  return true;
-}
-
 ReconstructRequest RequestFromFlags() {
   ReconstructRequest request;
   request.data_path = FLAGS_data;
@@ -322,19 +371,7 @@ ReconstructRequest RequestFromFlags() {
   request.exposure_s = FLAGS_exposure_s;
   request.fps = FLAGS_fps;
 
-  BinningOptions& binning = request.binning;
-  if (FLAGS_binning == "auto") {
-    binning.method = BinningOptions::Method::kAuto;
-  } else if (FLAGS_binning == "collision") {
-    binning.method = BinningOptions::Method::kCollision;
-  } else if (FLAGS_binning == "stacked") {
-    binning.method = BinningOptions::Method::kStacked;
-  } else {
-    throw InvalidArgumentError("--binning must be auto, collision or stacked");
-  }
-  binning.max_latent_frames = FLAGS_max_latent_frames;
-  binning.max_latent_voxels = FLAGS_max_latent_voxels;
-  binning.stacked.num_frames = FLAGS_stacked_frames;
+  request.binning = BinningFromFlags();
 
   MethodOptions& method = request.method;
   method.method = ParseMethod(FLAGS_solver);
@@ -383,14 +420,18 @@ ReconstructRequest RequestFromFlags() {
   return request;
 }
 
-int RunReconstruct() {
+int RunReconstruct(ProgressReporter* progress) {
   Require(!FLAGS_data.empty(), "reconstruct needs --data=DIR or --data=FILE.h5");
   Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
   Require(FLAGS_first >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
   ReconstructRequest request = RequestFromFlags();
   OutputTarget out(OutputFromFlags("reconstruct", FLAGS_data));
-  if (FLAGS_progress || ::isatty(STDERR_FILENO)) request.progress = PrintProgress;
+  // A line per iteration on a terminal; elsewhere the solve keeps its speed (an iteration
+  // callback solves independent parts one after another).
+  if (FLAGS_progress || ::isatty(STDERR_FILENO)) request.progress = progress->callback();
+  request.stage = [progress](const char* stage) { progress->StartStage(stage); };
   ReconstructResult result = RunReconstruction(request);
+  progress->StartStage("write");
   WriteReconstruction(request, &result, out.staging());
   out.Commit();
 
@@ -399,6 +440,10 @@ int RunReconstruct() {
               ModeName(result.mode), result.width, result.height,
               static_cast<long long>(result.events), result.event_frames,
               run.video.num_frames());
+  if (result.hot_pixels > 0) {
+    std::printf("hot pixels: %d, their %lld events left out (--hot_pixel_factor)\n",
+                result.hot_pixels, static_cast<long long>(result.hot_pixel_events));
+  }
   if (IsIterative(request.method.method)) {
     std::printf("model: %s\n", run.reconstruction.model.description.c_str());
     if (run.solved) {
@@ -427,8 +472,16 @@ int RunReconstruct() {
 }
 
 int RunCommand(const std::string& command) {
+  Require(std::isfinite(FLAGS_progress_interval_s) && FLAGS_progress_interval_s >= 0.0,
+          "--progress_interval_s must be a number of seconds, 0 or more");
+  // Lines on stderr while the command runs, only when it runs long (app/progress.h).
+  ProgressOptions progress_options;
+  progress_options.prefix = "evfs " + command;
+  progress_options.interval_s = FLAGS_progress_interval_s;
+  progress_options.every_iteration = FLAGS_progress || ::isatty(STDERR_FILENO);
+  ProgressReporter progress(progress_options);
   if (command == "info") return RunInfo();
-  if (command == "reconstruct") return RunReconstruct();
+  if (command == "reconstruct") return RunReconstruct(&progress);
   if (command == "simulate") return RunSimulate();
   if (command == "convert") return RunConvert();
   if (command == "demo") {
@@ -444,6 +497,90 @@ int RunCommand(const std::string& command) {
                              "(evfs --help)");
 }
 
+// What a value of a flag of gflags type `type` must look like.
+std::string ExpectedValue(const std::string& type) {
+  if (type == "bool") return "true or false";
+  if (type == "int32") return "a whole number (32-bit)";
+  if (type == "int64") return "a whole number";
+  if (type == "uint32" || type == "uint64") return "a whole number, 0 or more";
+  if (type == "double") return "a number";
+  return "a " + type;
+}
+
+// gflags reports a flag it cannot parse in its own words, possibly on several lines, and exits
+// with status 1. This reads the command line as gflags will (--name=value, --name value,
+// --name and --noname for booleans, "--" ending the flags) and tries each value in a
+// FlagSaver's scope, which puts every flag back. Returns the first problem, "" when none.
+// --flagfile is only checked for being readable; gflags reports what is inside it.
+std::string FirstFlagError(int argc, char** argv) {
+  const gflags::FlagSaver put_flags_back;
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument.size() < 2 || argument[0] != '-') continue;  // the command, or "-"
+    const size_t dashes = argument[1] == '-' ? 2 : 1;
+    if (argument.size() == dashes) break;  // "--"
+    const size_t equals = argument.find('=');
+    const bool has_value = equals != std::string::npos;
+    const std::string name =
+        argument.substr(dashes, has_value ? equals - dashes : std::string::npos);
+    gflags::CommandLineFlagInfo info;
+    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info)) {
+      gflags::CommandLineFlagInfo negated;
+      if (!has_value && name.rfind("no", 0) == 0 &&
+          gflags::GetCommandLineFlagInfo(name.substr(2).c_str(), &negated) &&
+          negated.type == "bool") {
+        continue;
+      }
+      return "unknown flag --" + name + " (evfs --help lists the flags)";
+    }
+    std::string value;
+    if (has_value) {
+      value = argument.substr(equals + 1);
+    } else if (info.type == "bool") {
+      value = "true";
+    } else if (i + 1 < argc) {
+      value = argv[++i];
+    } else {
+      return "--" + name + " needs a value";
+    }
+    if (name == "flagfile") {
+      std::stringstream files(value);
+      for (std::string file; std::getline(files, file, ',');) {
+        if (!std::ifstream(file)) return "--flagfile=" + value + ": cannot read " + file;
+      }
+      continue;
+    }
+    if (gflags::SetCommandLineOption(name.c_str(), value.c_str()).empty()) {
+      return "--" + name + "=" + value + ": expected " + ExpectedValue(info.type);
+    }
+  }
+  return "";
+}
+
+std::string FlagValue(const char* name) {
+  std::string value;
+  gflags::GetCommandLineOption(name, &value);
+  return value;
+}
+
+// gflags' help flags print and then exit with status 1; help asked for is a success. Prints
+// what gflags would and returns true when one was given.
+bool ShowHelpAskedFor(const char* argv0) {
+  if (FlagValue("help") == "true" || FlagValue("helpfull") == "true" ||
+      FlagValue("helppackage") == "true") {
+    gflags::ShowUsageWithFlags(argv0);
+  } else if (FlagValue("helpshort") == "true") {
+    gflags::ShowUsageWithFlagsRestrict(argv0, "evfs_main");
+  } else if (!FlagValue("helpon").empty()) {
+    gflags::ShowUsageWithFlagsRestrict(argv0, ("/" + FlagValue("helpon") + ".").c_str());
+  } else if (!FlagValue("helpmatch").empty()) {
+    gflags::ShowUsageWithFlagsRestrict(argv0, FlagValue("helpmatch").c_str());
+  } else {
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 }  // namespace evfs
 
@@ -451,7 +588,19 @@ int main(int argc, char** argv) {
   evfs::KeepFreedMemoryForReuse();
   gflags::SetUsageMessage(evfs::kUsage);
   gflags::SetVersionString("0.1.0");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  // Libraries' log messages (Ceres' dump of a residual block it could not evaluate, its
+  // "Terminating: ...") are for developers: shown with --minloglevel=0. What failed is evfs'
+  // own one line.
+  gflags::SetCommandLineOptionWithMode("minloglevel", "3", gflags::SET_FLAGS_DEFAULT);
+  // A flag gflags cannot parse is a user error like any other: one line, status 2.
+  const std::string flag_error = evfs::FirstFlagError(argc, argv);
+  if (!flag_error.empty()) {
+    std::fprintf(stderr, "evfs: %s\n", flag_error.c_str());
+    return evfs::kExitUserError;
+  }
+  gflags::ParseCommandLineNonHelpFlags(&argc, &argv, true);
+  if (evfs::ShowHelpAskedFor(argv[0])) return evfs::kExitSuccess;
+  gflags::HandleCommandLineHelpFlags();  // --version (status 0), --helpxml (status 1)
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   if (argc != 2) {
@@ -459,9 +608,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string command = argv[1];
+  // A failed CHECK is evfs' bug, not the user's: one line, status 3 (app/crash_guard.h).
+  evfs::InstallInternalErrorReporting("evfs " + command);
   const auto run = [&command] {
     try {
       return evfs::RunCommand(command);
+    } catch (const evfs::SolverError& error) {
+      std::fprintf(stderr, "evfs %s: %s\n", command.c_str(), error.what());
+      return static_cast<int>(evfs::kExitSolverFailure);
     } catch (const evfs::Error& error) {
       std::fprintf(stderr, "evfs %s: %s\n", command.c_str(), error.what());
       return 2;
@@ -472,7 +626,7 @@ int main(int argc, char** argv) {
   };
   // Every command runs in a worker process: a signal or a crash there leaves no unfinished
   // output (the parent removes it), and a corrupt .h5 file that crashes libhdf5 is a user error
-  // (examples/crash_guard.h). `convert --overwrite` opens the .h5 file it would replace.
+  // (app/crash_guard.h). `convert --overwrite` opens the .h5 file it would replace.
   std::string hdf5_path;
   if (evfs::IsHdf5Path(FLAGS_data)) {
     hdf5_path = FLAGS_data;

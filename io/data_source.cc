@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "io/aedat4.h"
 #include "io/hdf5_io.h"
 #include "io/text_folder.h"
 
@@ -34,11 +35,17 @@ std::unique_ptr<DataSource> DataSource::Open(const std::string& path) {
     return std::make_unique<TextFolderDataSource>(path);
   }
   if (IsHdf5Path(path)) return std::make_unique<Hdf5DataSource>(path);
+  // An AEDAT file by its name, or by its version line whatever its name (DV's .aedat4, an older
+  // version, which the reader names in its error).
+  if (IsAedat4Path(path) || StartsWithAedatVersionLine(path)) {
+    return std::make_unique<Aedat4DataSource>(path);
+  }
   if (!std::filesystem::exists(path, error)) {
-    throw InputError(InputError::Kind::kMissingFile, path, 0, "no such data folder or HDF5 file");
+    throw InputError(InputError::Kind::kMissingFile, path, 0,
+                     "no such data folder, HDF5 or AEDAT 4 file");
   }
   throw InputError(InputError::Kind::kMalformed, path, 0,
-                   "expected a data folder or an .h5/.hdf5 file");
+                   "expected a data folder, an .h5/.hdf5 or an .aedat4 file");
 }
 
 void ConvertRecording(const std::string& input, const std::string& output) {
@@ -50,6 +57,8 @@ void ConvertRecording(const std::string& input, const std::string& output) {
   }
   if (IsHdf5Path(output)) {
     WriteHdf5(output, events, source->frames(), images);
+  } else if (IsAedat4Path(output)) {
+    WriteAedat4(output, events, source->frames(), images);
   } else {
     WriteDataFolder(output, events, source->frames(), images);
   }

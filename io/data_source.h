@@ -54,7 +54,8 @@ struct EventSummary {
 /// A recording opened for reading. Not thread-safe (HDF5 is built serial).
 class DataSource {
  public:
-  /// Opens a data folder (text layout) or an .h5/.hdf5 file. Throws InputError when the path is
+  /// Opens a data folder (text layout), an .h5/.hdf5 file or an AEDAT 4 file (.aedat4, or any
+  /// file starting with an AEDAT version line; io/aedat4.h). Throws InputError when the path is
   /// missing, of an unknown kind, or malformed.
   static std::unique_ptr<DataSource> Open(const std::string& path);
 
@@ -67,6 +68,8 @@ class DataSource {
   int height() const { return height_; }
   /// The frames in images.txt order (strictly increasing timestamps).
   const std::vector<FrameInfo>& frames() const { return frames_; }
+  /// Why frames() is empty, for messages ("there is no DIR/images.txt"); "" when it is not.
+  const std::string& no_frames_reason() const { return no_frames_reason_; }
 
   /// Frame `index` (0-based, as in frames()) as grey values in [0, 1]. Throws InputError when
   /// the image is missing, unreadable or not of the sensor size, InvalidArgumentError for an
@@ -89,14 +92,17 @@ class DataSource {
   int width_ = 0;
   int height_ = 0;
   std::vector<FrameInfo> frames_;
+  std::string no_frames_reason_;  // set by the subclass when frames_ is empty
 };
 
 /// True when `path` names an HDF5 file by its extension (.h5 or .hdf5, any case).
 bool IsHdf5Path(const std::string& path);
 
-/// Copies a recording from `input` (folder or HDF5 file) to `output` (an .h5/.hdf5 path gives
-/// HDF5, anything else a data folder), losslessly: events to the nanosecond, frames with their
-/// pixel values and bit depth, timestamps, exposures and images.txt paths.
+/// Copies a recording from `input` (folder, HDF5 or AEDAT 4 file) to `output` (an .h5/.hdf5
+/// path gives HDF5, an .aedat4 path AEDAT 4, anything else a data folder), losslessly: events to
+/// the nanosecond, frames with their pixel values and bit depth, timestamps, exposures and
+/// images.txt paths. AEDAT 4 keeps times to the microsecond and 8-bit frames only (WriteAedat4
+/// rounds the times and refuses finer pixels).
 void ConvertRecording(const std::string& input, const std::string& output);
 
 }  // namespace evfs

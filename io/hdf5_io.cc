@@ -40,6 +40,9 @@ constexpr char kEvfs[] = "evfs";
 constexpr size_t kMaxImageNameBytes = 64;
 // Event coordinates are uint16, so no sensor side is longer.
 constexpr hsize_t kMaxImageSide = 65536;
+// Most pixels a sensor may have (8192 x 8192, far beyond any event camera's 1280 x 960): a
+// declared size is allocated for (frames, per-pixel counts), so it is bounded before it is.
+constexpr int64_t kMaxSensorPixels = int64_t{1} << 26;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
 
@@ -306,6 +309,7 @@ class Hdf5DataSource::File {
   int width() const { return width_; }
   int height() const { return height_; }
   std::vector<FrameInfo>& frames() { return frames_; }
+  bool has_images_group() const { return has_images_group_; }
 
   // Sensor size used to validate coordinates (0 = only the uint16 range).
   void set_sensor_size(int width, int height) {
@@ -527,12 +531,25 @@ class Hdf5DataSource::File {
         resolution[1] > 65536) {
       h5_.Fail(InputError::Kind::kOutOfRange, what + " must hold a positive [height, width]");
     }
+    CheckSensorPixels(what + " declares a", resolution[1], resolution[0]);
     height_ = static_cast<int>(resolution[0]);
     width_ = static_cast<int>(resolution[1]);
   }
 
+  // Fails when a width x height sensor (each side already at most 65536) is beyond
+  // kMaxSensorPixels; `what` names where the size comes from.
+  void CheckSensorPixels(const std::string& what, int64_t width, int64_t height) const {
+    if (width * height > kMaxSensorPixels) {
+      h5_.Fail(InputError::Kind::kOutOfRange,
+               what + " " + std::to_string(width) + "x" + std::to_string(height) +
+                   " sensor: more than the " + std::to_string(kMaxSensorPixels) +
+                   " pixels (8192x8192) evfs reads");
+    }
+  }
+
   void ReadFrames() {
-    if (H5Lexists(file_.get(), kImagesGroup, H5P_DEFAULT) <= 0) return;
+    has_images_group_ = H5Lexists(file_.get(), kImagesGroup, H5P_DEFAULT) > 0;
+    if (!has_images_group_) return;
     const Handle group = h5_.Check(H5Gopen2(file_.get(), kImagesGroup, H5P_DEFAULT), H5Gclose,
                                    "cannot open group images");
     H5G_info_t info;
@@ -564,8 +581,18 @@ class Hdf5DataSource::File {
                    full + " is " + std::to_string(dims[1]) + "x" + std::to_string(dims[0]) +
                        ": each side must be 1 to " + std::to_string(kMaxImageSide) + " pixels");
         }
+        CheckSensorPixels(full + " is a frame of a", static_cast<int64_t>(dims[1]),
+                          static_cast<int64_t>(dims[0]));
         height_ = static_cast<int>(dims[0]);
         width_ = static_cast<int>(dims[1]);
+      }
+      // Every frame has the sensor's size, checked before anything is allocated for either: a
+      // sensor_resolution of 65535x65535 over 240x180 frames made `info` allocate for 4 G
+      // pixels. Compared as hsize_t, like ReadImage does.
+      if (dims[0] != static_cast<hsize_t>(height_) || dims[1] != static_cast<hsize_t>(width_)) {
+        h5_.Fail(InputError::Kind::kSizeMismatch,
+                 full + " is " + std::to_string(dims[1]) + "x" + std::to_string(dims[0]) +
+                     ", the sensor is " + std::to_string(width_) + "x" + std::to_string(height_));
       }
       FrameInfo frame;
       frame.t_ns = SecondsToNanoseconds(ReadDoubleAttribute(h5_, dataset.get(), kTimestamp, full));
@@ -614,6 +641,7 @@ class Hdf5DataSource::File {
   int height_ = 0;
   std::vector<FrameInfo> frames_;
   std::vector<std::string> image_datasets_;  // names inside /images, in frames_ order
+  bool has_images_group_ = false;
 };
 
 Hdf5DataSource::Hdf5DataSource(const std::string& path)
@@ -622,6 +650,10 @@ Hdf5DataSource::Hdf5DataSource(const std::string& path)
 Hdf5DataSource::Hdf5DataSource(std::unique_ptr<File> file)
     : DataSource(file->h5().path(), file->width(), file->height(), std::move(file->frames())),
       file_(std::move(file)) {
+  if (frames_.empty()) {
+    no_frames_reason_ =
+        file_->has_images_group() ? "its group /images holds no image" : "it has no group /images";
+  }
   if (width_ == 0 || height_ == 0) {
     // Neither sensor_resolution nor frames: the events say how large the sensor is at least.
     const EventSummary summary = Summarize();

@@ -3,7 +3,7 @@
 //
 // Nothing can clean up reliably inside the process that a signal is ending: a signal handler
 // may not remove a folder tree, and while one thread removes it another may still be writing
-// into it. So the CLI runs each command in a worker child (examples/crash_guard.h) and cleans up
+// into it. So the CLI runs each command in a worker child (app/crash_guard.h) and cleans up
 // from the parent, once the worker is gone and nothing writes any more: the worker reports
 // through a pipe each path it starts writing and each it has finished with (ScopedCleanupPath,
 // used by OutputTarget); the parent removes the paths still open when the worker ended.

@@ -22,15 +22,28 @@ bool IsFile(const fs::path& path) {
   return fs::is_regular_file(path, error);
 }
 
+// Throws when `path` exists but is no regular file (a folder, a FIFO, a device): reading it
+// would fail or block, and calling it missing would mislead. `expected` says what it should be.
+void CheckRegularFileIfPresent(const fs::path& path, const char* expected) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (!fs::exists(status) || fs::is_regular_file(status)) return;
+  throw InputError(InputError::Kind::kMalformed, path.string(), 0,
+                   std::string(fs::is_directory(status) ? "a folder" : "a FIFO, socket or device") +
+                       ", not " + expected);
+}
+
 std::vector<FrameInfo> ReadFolderFrames(const std::string& folder) {
   std::error_code error;
   if (!fs::is_directory(folder, error)) {
     throw InputError(InputError::Kind::kMissingFile, folder, 0, "data folder does not exist");
   }
   const fs::path images_txt = fs::path(folder) / kImagesFile;
+  CheckRegularFileIfPresent(images_txt, "a file of frames ('t path' lines)");
   if (!IsFile(images_txt)) return {};
   std::vector<FrameInfo> frames = ReadFrameList(images_txt.string());
   const fs::path exposures_txt = fs::path(folder) / kExposuresFile;
+  CheckRegularFileIfPresent(exposures_txt, "a file of exposures ('path t_start t_end' lines)");
   if (IsFile(exposures_txt)) ReadExposures(exposures_txt.string(), &frames);
   return frames;
 }
@@ -59,12 +72,18 @@ TextFolderDataSource::TextFolderDataSource(const std::string& folder)
 TextFolderDataSource::TextFolderDataSource(const std::string& folder, std::vector<FrameInfo> frames)
     : DataSource(folder, 0, 0, std::move(frames)) {
   const std::string events_txt = (fs::path(folder) / kEventsFile).string();
+  const std::string images_txt = (fs::path(folder) / kImagesFile).string();
+  CheckRegularFileIfPresent(events_txt, "a file of events ('t x y p' lines)");
+  if (frames_.empty()) {
+    no_frames_reason_ =
+        IsFile(images_txt) ? images_txt + " lists none" : "there is no " + images_txt;
+  }
   if (!IsFile(events_txt)) {
     // A folder of frames alone (a ground-truth clip to simulate events from) is a recording
     // without events: it can be described and simulated, and reading its events says why not.
     if (frames_.empty()) {
       throw InputError(InputError::Kind::kMissingFile, events_txt, 0,
-                       "events file does not exist (and images.txt lists no frames)");
+                       "does not exist, and " + no_frames_reason_ + ": not a data folder");
     }
     const Image first = ReadGreyImage((fs::path(folder) / frames_.front().path).string());
     width_ = static_cast<int>(first.cols());

@@ -8,6 +8,11 @@ packages=(
   cmake make g++ pkg-config
   libceres-dev libeigen3-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev
+  # AEDAT 4 (io/aedat4.cc); the python3 modules decode the real sample independently in a test.
+  libflatbuffers-dev flatbuffers-compiler liblz4-dev libzstd-dev libtinyxml2-dev
+  python3-lz4 python3-zstandard python3-flatbuffers
+  # benchmarks/plot_methods.py: method_benchmark's PSNR-against-time plots.
+  python3-matplotlib
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-dev)

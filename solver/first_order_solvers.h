@@ -21,11 +21,11 @@
 #include <string>
 
 #include "core/video.h"
-#include "solver/activity_mask.h"
+#include "scene/activity_mask.h"
 #include "solver/fused_objective.h"
 #include "solver/iteration_callback.h"
 #include "solver/reconstruction_options.h"
-#include "solver/scene.h"
+#include "scene/scene.h"
 
 namespace evfs {
 

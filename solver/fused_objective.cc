@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "core/error.h"
-#include "cost_functions/event_model.h"
+#include "scene/event_model.h"
 #include "cost_functions/weighted_l1_loss.h"
 
 namespace evfs {

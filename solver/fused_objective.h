@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "core/video.h"
-#include "solver/activity_mask.h"
+#include "scene/activity_mask.h"
 #include "solver/reconstruction_options.h"
-#include "solver/scene.h"
+#include "scene/scene.h"
 
 namespace evfs {
 

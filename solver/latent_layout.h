@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "core/video.h"
-#include "solver/activity_mask.h"
-#include "solver/scene.h"
+#include "scene/activity_mask.h"
+#include "scene/scene.h"
 
 namespace evfs {
 

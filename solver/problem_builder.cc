@@ -311,26 +311,4 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
   return built;
 }
 
-Video InitializeLatentVideo(const Scene& scene) {
-  const std::vector<int64_t>& latent_ns = scene.latent_timestamps_ns();
-  // Each observation sits at the centre of its exposure on the latent timeline.
-  Video anchors;
-  std::vector<const FrameObservation*> sorted;
-  for (const FrameObservation& frame : scene.frames) sorted.push_back(&frame);
-  std::stable_sort(sorted.begin(), sorted.end(), [&](const auto* a, const auto* b) {
-    return a->latent_first + a->latent_last < b->latent_first + b->latent_last;
-  });
-  for (const FrameObservation* frame : sorted) {
-    const int64_t centre_ns = (latent_ns[frame->latent_first] + latent_ns[frame->latent_last]) / 2;
-    if (!anchors.empty() && anchors.timestamp_ns(anchors.num_frames() - 1) == centre_ns) continue;
-    anchors.AppendFrame(frame->image, centre_ns);
-  }
-  Video latent(scene.height, scene.width, static_cast<int>(latent_ns.size()));
-  for (int t = 0; t < latent.num_frames(); ++t) {
-    latent.set_timestamp_ns(t, latent_ns[t]);
-    latent.frame(t) = anchors.InterpolateAt(latent_ns[t]);
-  }
-  return latent;
-}
-
 }  // namespace evfs

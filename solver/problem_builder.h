@@ -13,7 +13,7 @@
 #include "core/video.h"
 #include "solver/latent_layout.h"
 #include "solver/reconstruction_options.h"
-#include "solver/scene.h"
+#include "scene/scene.h"
 
 namespace evfs {
 
@@ -88,10 +88,6 @@ class ProblemBuilder {
   const Scene& scene_;
   const ReconstructionOptions& options_;
 };
-
-/// The initialisation of DESIGN.md §1: the frame observations blended linearly along the latent
-/// timeline (a copy when there is only one, held constant beyond the first and last).
-Video InitializeLatentVideo(const Scene& scene);
 
 }  // namespace evfs
 

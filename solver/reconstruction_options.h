@@ -8,9 +8,9 @@
 
 #include <ceres/ceres.h>
 
-#include "cost_functions/event_model.h"
+#include "scene/event_model.h"
 #include "cost_functions/spatial_tv_residual.h"
-#include "solver/event_model_estimation.h"
+#include "scene/event_model_estimation.h"
 
 namespace evfs {
 

@@ -203,7 +203,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   }
   summary.iterations += iterations;
   if (summary.ceres.termination_type == ceres::FAILURE) {
-    throw InvalidArgumentError("the solve failed: " + summary.ceres.message);
+    throw SolverError("the solver failed: " + summary.ceres.message);
   }
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;

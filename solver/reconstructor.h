@@ -7,11 +7,11 @@
 #include <ceres/ceres.h>
 
 #include "core/video.h"
-#include "solver/event_model_estimation.h"
+#include "scene/event_model_estimation.h"
 #include "solver/iteration_callback.h"
 #include "solver/problem_builder.h"
 #include "solver/reconstruction_options.h"
-#include "solver/scene.h"
+#include "scene/scene.h"
 
 namespace evfs {
 
@@ -40,7 +40,7 @@ struct Reconstruction {
 /// Reconstructs the latent video of `scene`, starting from `initial` (the scene's latent
 /// timeline; e.g. a classical estimate from baselines/) or, when null, from
 /// InitializeLatentVideo(scene). Throws InvalidArgumentError for invalid options or an initial
-/// video of another shape. α <= 0 in the options is derived from the scene first. A scene
+/// video of another shape, SolverError when Ceres ends with FAILURE. α <= 0 in the options is derived from the scene first. A scene
 /// without events is answered with its initialisation, without a solve.
 /// `callback`, when given, sees every Ceres iteration with the current latent video.
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,

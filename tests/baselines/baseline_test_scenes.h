@@ -4,8 +4,8 @@
 
 #include "core/metrics.h"
 #include "core/video.h"
-#include "solver/scene.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "scene/scene.h"
+#include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace testing {

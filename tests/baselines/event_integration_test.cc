@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "events/simulator.h"
-#include "solver/problem_builder.h"
+#include "scene/scene.h"
 #include "tests/baselines/baseline_test_scenes.h"
 
 namespace evfs {

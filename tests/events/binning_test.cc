@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -345,6 +347,101 @@ TEST(BinStacked, RejectsInvalidOptionsAndShortWindows) {
   options.steps_per_frame = 20;
   EXPECT_THROW(BinStacked(events, 0, 100, options), InvalidArgumentError);  // 200 steps > 100 ns
   EXPECT_THROW(BinStacked(events, 100, 0, StackedBinningOptions()), InvalidArgumentError);
+
+  // M · S must stay an int latent index.
+  options = StackedBinningOptions();
+  options.num_frames = 1 << 16;
+  options.steps_per_frame = 1 << 16;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("num_frames * steps_per_frame"), std::string::npos) << error;
+}
+
+// Regression (issue 14): a window too short for the frames was found only after allocating one
+// boundary per frame (16 GB for 2^31 - 2 frames); it is refused first.
+TEST(BinStacked, ShortWindowIsRefusedBeforeAllocating) {
+  const EventStream events = RandomEvents(10, 0, 100, kSeed);
+  StackedBinningOptions options;
+  options.num_frames = std::numeric_limits<int>::max() - 1;
+  EXPECT_THROW(BinStacked(events, 0, 100, options), InvalidArgumentError);
+}
+
+TEST(CountCollisionFrames, AgreesWithBinByCollision) {
+  const EventStream events = RandomEvents(5000, 0, 1000000, kSeed);
+  for (const auto& [begin_ns, end_ns] : std::vector<std::pair<int64_t, int64_t>>{
+           {0, 1000000}, {100000, 900000}, {5000, 6000}, {0, 1}, {999999, 2000000}}) {
+    EXPECT_EQ(CountCollisionFrames(events, begin_ns, end_ns),
+              BinByCollision(events, begin_ns, end_ns).num_frames())
+        << begin_ns << ", " << end_ns;
+  }
+  EventStream one_pixel(4, 4);
+  for (int i = 1; i <= 10; ++i) one_pixel.push_back(100 * i, 2, 3, 1);
+  EXPECT_EQ(CountCollisionFrames(one_pixel, 0, 1100), 10);
+  EXPECT_THROW(CountCollisionFrames(one_pixel, 10, 10), InvalidArgumentError);
+  EventStream off_sensor(2, 2);
+  off_sensor.push_back(5, 2, 0, 1);
+  EXPECT_THROW(CountCollisionFrames(off_sensor, 0, 10), InvalidArgumentError);
+}
+
+TEST(MeasurePixelActivity, HandComputedHotPixel) {
+  // 300 pixels fire once or twice, pixel (1, 0) 25 times: the reference is the busiest pixel
+  // outside the busiest 1 % (rank 3), which fired twice.
+  EventStream events(20, 20);
+  int64_t t_ns = 0;
+  for (int p = 0; p < 300; ++p) {
+    const int repeats = p < 100 ? 2 : 1;
+    for (int r = 0; r < repeats; ++r) {
+      events.push_back(++t_ns, static_cast<uint16_t>(p % 20), static_cast<uint16_t>(p / 20), 1);
+    }
+  }
+  // Pixel 1 already fired twice above; 23 more make 25.
+  for (int i = 0; i < 23; ++i) events.push_back(++t_ns, 1, 0, i % 2 ? 1 : -1);
+  const PixelActivity activity = MeasurePixelActivity(events, 0, t_ns + 1, 10.0);
+  EXPECT_EQ(activity.num_events, 423);
+  EXPECT_EQ(activity.pixels_fired, 300);
+  EXPECT_EQ(activity.busiest_count, 25);
+  EXPECT_EQ(activity.reference_count, 2);
+  EXPECT_EQ(activity.hot_pixels, std::vector<int32_t>{1});
+  EXPECT_EQ(activity.hot_pixel_events, 25);
+  // 25 is not more than 12.5 times 2; a factor of 0 finds none.
+  EXPECT_TRUE(MeasurePixelActivity(events, 0, t_ns + 1, 12.5).hot_pixels.empty());
+  EXPECT_TRUE(MeasurePixelActivity(events, 0, t_ns + 1, 0.0).hot_pixels.empty());
+}
+
+TEST(MeasurePixelActivity, OnePixelAloneIsNotHot) {
+  EventStream events(4, 4);
+  for (int i = 1; i <= 1000; ++i) events.push_back(i, 2, 3, 1);
+  const PixelActivity alone = MeasurePixelActivity(events, 0, 1001, 10.0);
+  EXPECT_EQ(alone.pixels_fired, 1);
+  EXPECT_TRUE(alone.hot_pixels.empty());
+  // With a second pixel to compare with, it is.
+  events.push_back(1001, 0, 0, 1);
+  const PixelActivity pair = MeasurePixelActivity(events, 0, 1002, 10.0);
+  EXPECT_EQ(pair.reference_count, 1);
+  EXPECT_EQ(pair.hot_pixels, std::vector<int32_t>{3 * 4 + 2});
+  EXPECT_EQ(pair.hot_pixel_events, 1000);
+  const PixelActivity empty = MeasurePixelActivity(events, 5000, 6000, 10.0);
+  EXPECT_EQ(empty.num_events, 0);
+  EXPECT_EQ(empty.pixels_fired, 0);
+}
+
+TEST(WithoutPixels, DropsExactlyThosePixels) {
+  const EventStream events = RandomEvents(2000, 0, 100000, kSeed);
+  const std::vector<int32_t> dropped = {0, 5, kWidth * kHeight - 1};
+  const EventStream kept = WithoutPixels(events, dropped);
+  EXPECT_EQ(kept.width(), kWidth);
+  EXPECT_EQ(kept.height(), kHeight);
+  size_t expected = 0;
+  for (size_t i = 0; i < events.size(); ++i) {
+    const int32_t pixel = events.y(i) * kWidth + events.x(i);
+    expected += std::find(dropped.begin(), dropped.end(), pixel) == dropped.end();
+  }
+  ASSERT_EQ(kept.size(), expected);
+  EXPECT_TRUE(kept.IsSorted());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    const int32_t pixel = kept.y(i) * kWidth + kept.x(i);
+    EXPECT_EQ(std::find(dropped.begin(), dropped.end(), pixel), dropped.end());
+  }
+  EXPECT_EQ(WithoutPixels(events, {}), events);
 }
 
 }  // namespace

@@ -146,6 +146,35 @@ TEST(EventSimulator, NoiseRateGivesTheExpectedCount) {
   EXPECT_LE(events.last_t_ns(), kNanosecondsPerSecond);
 }
 
+// Regression (issue 14): noise_rate_hz = 1e12 drew events until memory ran out (bad_alloc). The
+// expected count is known before drawing, so it is refused at once, for the whole video and
+// for one Advance alike.
+TEST(EventSimulator, NoiseBeyondTheEventBudgetIsRefusedBeforeDrawing) {
+  const Video video =
+      ConstantVideo(Image::Constant(32, 32, 0.5), 3, kNanosecondsPerSecond / 10);
+  SimulatorOptions options;
+  options.noise_rate_hz = 1e12;
+  try {
+    SimulateEvents(video, options);
+    ADD_FAILURE() << "expected an InvalidArgumentError";
+  } catch (const InvalidArgumentError& error) {
+    EXPECT_NE(std::string(error.what()).find("max_events"), std::string::npos) << error.what();
+  }
+  EventSimulator simulator(32, 32, options);
+  simulator.Reset(video.frame(0), 0);
+  EXPECT_THROW(simulator.Advance(video.frame(1), kNanosecondsPerSecond / 10),
+               InvalidArgumentError);
+
+  // The budget is an option: 10 Hz over 1024 pixels and 0.2 s is about 2048 events.
+  options.noise_rate_hz = 10.0;
+  options.max_events = 1000;
+  EXPECT_THROW(SimulateEvents(video, options), InvalidArgumentError);
+  options.max_events = 100000;
+  EXPECT_GT(SimulateEvents(video, options).size(), 1000u);
+  options.max_events = 0;
+  EXPECT_FALSE(options.IsValid(nullptr));
+}
+
 TEST(EventSimulator, RefractoryPeriodIsRespected) {
   // Each frame interval (1 ms) ramps every pixel between 0.02 and 0.9, about 19 thresholds of
   // log intensity, so pixels want to fire every ~50 µs.

@@ -4,6 +4,7 @@
 #define EVFS_TESTS_EXAMPLES_CLI_TEST_UTIL_H_
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -41,7 +42,9 @@ inline std::string ReadFile(const fs::path& path) {
 // collects what it printed.
 inline CommandResult RunEvfs(const std::string& arguments, const std::string& shell_prefix = "") {
   fs::create_directories(EVFS_TEST_TMP_DIR);
-  const fs::path stderr_file = fs::path(EVFS_TEST_TMP_DIR) / "stderr.txt";
+  // One file per process: ctest runs the tests of one executable side by side.
+  const fs::path stderr_file =
+      fs::path(EVFS_TEST_TMP_DIR) / ("stderr_" + std::to_string(::getpid()) + ".txt");
   const std::string command = shell_prefix + std::string(EVFS_BINARY) + " " + arguments + " 2>" +
                               stderr_file.string();
   CommandResult result;
@@ -53,6 +56,7 @@ inline CommandResult RunEvfs(const std::string& arguments, const std::string& sh
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   result.errors = ReadFile(stderr_file);
   result.output += result.errors;
+  fs::remove(stderr_file);
   return result;
 }
 

@@ -275,7 +275,7 @@ TEST(EvfsCli, CorruptOrIncompleteHdf5IsAUserError) {
 
 // Two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation fault
 // (in H5AC_protect's block read, and in H5Aexists). The CLI runs HDF5 commands in a child
-// process (examples/crash_guard.h), so they end as a user error, not as a crash.
+// process (app/crash_guard.h), so they end as a user error, not as a crash.
 TEST(EvfsCli, Hdf5FileThatCrashesLibhdf5IsAUserError) {
   // Under AddressSanitizer the crash must stay a signal, not become a sanitizer report.
   const char* asan = std::getenv("ASAN_OPTIONS");

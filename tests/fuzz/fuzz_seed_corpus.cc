@@ -4,19 +4,26 @@
 //                    so that windowed reads take the binary search
 //   OUT/frame_list/  every images.txt and exposures.txt, and each images.txt joined by a NUL
 //                    byte to the exposures.txt beside it (see frame_list_fuzzer.cc)
+//   OUT/aedat4/      the same tiny recordings written by WriteAedat4 with each compression
+//                    (several packets each, a data table), and the header and first packets
+//                    of the real DV recording with its table position set to -1 (no table)
 //   OUT/hdf5_io/     tiny recordings cut from the snippets and converted to HDF5 by
 //                    ConvertRecording, the code behind `evfs convert`
 //
 //   fuzz_seed_corpus DATA_DIR OUT
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
 
+#include <flatbuffers/flatbuffers.h>
+
 #include "core/error.h"
+#include "io/aedat4.h"
 #include "io/data_source.h"
 #include "io/event_text.h"
 #include "io/frame_list.h"
@@ -81,8 +88,58 @@ void WriteTinyRecording(const DataSource& source, bool with_frames, int64_t shif
   fs::remove_all(scratch);
 }
 
+// A tiny recording (an HDF5 seed) as AEDAT 4 with each compression, in packets of a few
+// events so that windowed reads seek.
+constexpr int kSeedEventsPerPacket = 8;
+
+void WriteAedat4Seeds(const fs::path& h5_path, const fs::path& out_stem) {
+  const auto source = DataSource::Open(h5_path.string());
+  if (source->width() <= 0) return;  // no events nor frames, so no sensor size: nothing to write
+  std::vector<Image> images;
+  for (int i = 0; i < static_cast<int>(source->frames().size()); ++i) {
+    images.push_back(source->ReadImage(i));
+  }
+  for (const Aedat4Compression compression :
+       {Aedat4Compression::kNone, Aedat4Compression::kLz4, Aedat4Compression::kZstd}) {
+    Aedat4WriteOptions options;
+    options.compression = compression;
+    options.max_events_per_packet = kSeedEventsPerPacket;
+    WriteAedat4(out_stem.string() + "_" + Aedat4CompressionName(compression) + ".aedat4",
+                source->ReadAllEvents(), source->frames(), images, options);
+  }
+}
+
+// The version line, IOHeader and first kDvSeedPackets packets of a DV recording, its
+// data_table_position (slot 1 of the IOHeader table) set to -1: a recording without a table.
+constexpr int kDvSeedPackets = 2;
+
+void WriteDvSeed(const fs::path& aedat4_path, const fs::path& seed_path) {
+  std::ifstream stream(aedat4_path, std::ios::binary);
+  const std::string file((std::istreambuf_iterator<char>(stream)),
+                         std::istreambuf_iterator<char>());
+  constexpr size_t kVersionLineBytes = 14;
+  if (file.size() < kVersionLineBytes + 4) return;
+  uint32_t header_bytes = 0;
+  std::memcpy(&header_bytes, file.data() + kVersionLineBytes, 4);
+  size_t end = kVersionLineBytes + 4 + header_bytes;
+  if (end > file.size()) return;
+  const std::vector<uint8_t> header(file.begin() + kVersionLineBytes, file.begin() + end);
+  const uint8_t* field =
+      flatbuffers::GetSizePrefixedRoot<flatbuffers::Table>(header.data())->GetAddressOf(6);
+  if (field == nullptr) return;
+  std::string seed = file;
+  const int64_t no_table = -1;
+  std::memcpy(&seed[kVersionLineBytes + static_cast<size_t>(field - header.data())], &no_table, 8);
+  for (int packet = 0; packet < kDvSeedPackets && end + 8 <= file.size(); ++packet) {
+    int32_t size = 0;
+    std::memcpy(&size, file.data() + end + 4, 4);
+    end += 8 + static_cast<size_t>(size);
+  }
+  WriteText(seed_path, seed.substr(0, std::min(end, file.size())));
+}
+
 int Run(const fs::path& data_dir, const fs::path& out) {
-  for (const char* target : {"event_text", "frame_list", "hdf5_io"}) {
+  for (const char* target : {"event_text", "frame_list", "hdf5_io", "aedat4"}) {
     fs::create_directories(out / target);
   }
   std::vector<fs::path> snippets;
@@ -116,7 +173,11 @@ int Run(const fs::path& data_dir, const fs::path& out) {
     WriteTinyRecording(*source, true, 0, out / "hdf5_io" / (name + ".h5"), scratch);
     WriteTinyRecording(*source, false, 0, out / "hdf5_io" / (name + "_events.h5"), scratch);
     WriteTinyRecording(*source, false, kFarFutureNs, out / "hdf5_io" / (name + "_ns.h5"), scratch);
+    WriteAedat4Seeds(out / "hdf5_io" / (name + ".h5"), out / "aedat4" / name);
+    WriteAedat4Seeds(out / "hdf5_io" / (name + "_ns.h5"), out / "aedat4" / (name + "_ns"));
   }
+  const fs::path dv_recording = data_dir / "aedat4_dvxplorer_sample" / "sample.aedat4";
+  if (fs::is_regular_file(dv_recording)) WriteDvSeed(dv_recording, out / "aedat4" / "dv_sample");
   std::printf("seed corpora from %zu snippets of %s in %s\n", snippets.size(), data_dir.c_str(),
               out.c_str());
   return 0;

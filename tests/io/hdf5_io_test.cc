@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tests/io/io_test_util.h"
@@ -212,6 +213,82 @@ TEST(Hdf5IoTest, InvalidEventsAreInputErrors) {
   EXPECT_EQ(source.ReadEvents(0, 1500).size(), 1u);
 }
 
+herr_t CountHdf5Errors(hid_t, void* count) {
+  ++*static_cast<int*>(count);
+  return 0;
+}
+
+// libhdf5's automatic error printing belongs to the process: evfs silences it only while it
+// calls libhdf5 itself, and puts back whatever handler was installed before.
+TEST(Hdf5IoTest, Hdf5ErrorPrintingIsSilencedOnlyWhileEvfsCallsLibhdf5) {
+  const std::string dir = testing::ScratchDir("h5_error_scope");
+  const std::string garbage = dir + "/garbage.h5";
+  testing::WriteFile(garbage, std::string(4096, 'x'));
+  H5E_auto2_t saved = nullptr;
+  void* saved_data = nullptr;
+  ASSERT_GE(H5Eget_auto2(H5E_DEFAULT, &saved, &saved_data), 0);
+  int errors = 0;
+  ASSERT_GE(H5Eset_auto2(H5E_DEFAULT, CountHdf5Errors, &errors), 0);
+
+  // evfs' own failing calls report nothing through the handler...
+  testing::ExpectInputError([&] { Hdf5DataSource source(garbage); }, InputError::Kind::kMalformed,
+                            garbage, 0);
+  EXPECT_FALSE(IsHdf5WrittenByEvfs(garbage));
+  const std::string unwritable = dir + "/no/such/folder/out.h5";
+  testing::ExpectInputError([&] { WriteHdf5(unwritable, EventStream(), {}, {}); },
+                            InputError::Kind::kUnwritable, unwritable, 0);
+  EXPECT_EQ(errors, 0);
+  // ...and leave it installed, so that a failing call of the process's own is still reported.
+  H5E_auto2_t current = nullptr;
+  void* current_data = nullptr;
+  ASSERT_GE(H5Eget_auto2(H5E_DEFAULT, &current, &current_data), 0);
+  EXPECT_EQ(current, &CountHdf5Errors);
+  EXPECT_EQ(current_data, &errors);
+  EXPECT_LT(H5Fopen(garbage.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), 0);
+  EXPECT_GT(errors, 0);
+  H5Eset_auto2(H5E_DEFAULT, saved, saved_data);
+}
+
+TEST(Hdf5IoTest, ScopedLibhdf5ReadMarksTheCallingThreadOnly) {
+  EXPECT_FALSE(InLibhdf5());
+  {
+    const ScopedLibhdf5Read reading;
+    EXPECT_TRUE(InLibhdf5());
+    {
+      const ScopedLibhdf5Read nested;
+      EXPECT_TRUE(InLibhdf5());
+    }
+    EXPECT_TRUE(InLibhdf5());
+    bool other_thread_marked = true;
+    std::thread([&] { other_thread_marked = InLibhdf5(); }).join();
+    EXPECT_FALSE(other_thread_marked);
+  }
+  EXPECT_FALSE(InLibhdf5());
+  // Reading leaves no mark behind, on success or failure.
+  const std::string dir = testing::ScratchDir("h5_marks");
+  const Recording recording = MakeRecording(3, 1000);
+  WriteHdf5(dir + "/good.h5", recording.events, recording.frames, recording.images);
+  {
+    const Hdf5DataSource source(dir + "/good.h5");
+    EXPECT_EQ(source.ReadAllEvents().size(), recording.events.size());
+    EXPECT_FALSE(InLibhdf5());
+  }
+  testing::WriteFile(dir + "/garbage.h5", std::string(4096, 'x'));
+  EXPECT_THROW(Hdf5DataSource source(dir + "/garbage.h5"), InputError);
+  EXPECT_FALSE(InLibhdf5());
+}
+
+// A folder (or FIFO) named like an HDF5 file exists: saying it does not would mislead.
+TEST(Hdf5IoTest, FolderNamedLikeAnHdf5FileIsNotAMissingFile) {
+  const std::string dir = testing::ScratchDir("h5_folder");
+  const std::string folder = dir + "/recording.h5";
+  std::filesystem::create_directories(folder);
+  const InputError error = testing::CatchInputError([&] { Hdf5DataSource source(folder); });
+  EXPECT_EQ(error.kind(), InputError::Kind::kMalformed);
+  EXPECT_NE(std::string(error.what()).find("not a regular file"), std::string::npos)
+      << error.what();
+}
+
 TEST(Hdf5IoTest, CorruptOrIncompleteFilesAreInputErrors) {
   const std::string dir = testing::ScratchDir("h5_corrupt");
   const Recording recording = MakeRecording(2, 100000);
@@ -344,10 +421,9 @@ TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {
   recording.images[1] = testing::MakeRandomImage(4, kWidth + 1, kHeight, 8);
   const std::string path = testing::ScratchDir("h5_size") + "/recording.h5";
   WriteHdf5(path, recording.events, recording.frames, recording.images);
-  const Hdf5DataSource source(path);
-  EXPECT_NO_THROW(source.ReadImage(0));
-  testing::ExpectInputError([&] { source.ReadImage(1); }, InputError::Kind::kSizeMismatch,
-                            "images/image000000001", 0);
+  // Found when the file opens, before any frame is read (issue 14).
+  testing::ExpectInputError([&] { Hdf5DataSource source(path); },
+                            InputError::Kind::kSizeMismatch, "images/image000000001", 0);
 }
 
 // A compressed dataset may declare any extent (its stored size says nothing about it). One of
@@ -384,9 +460,10 @@ TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
     H5Fclose(file);
     return path;
   };
-  // With the sensor size in the file, the first image is checked against it when read.
-  const Hdf5DataSource first(with_huge_image("first.h5", "images/image000000000"));
-  testing::ExpectInputError([&] { first.ReadImage(0); }, InputError::Kind::kSizeMismatch,
+  // With the sensor size in the file, every image is checked against it when the file opens.
+  const std::string first = with_huge_image("first.h5", "images/image000000000");
+  testing::ExpectInputError([&] { Hdf5DataSource source(first); },
+                            InputError::Kind::kSizeMismatch,
                             "images/image000000000 is 64x4294967344", 0);
   // Without, the first image sets it.
   const std::string unsized = with_huge_image("unsized.h5", "images/image000000000");
@@ -396,10 +473,56 @@ TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
   testing::ExpectInputError([&] { Hdf5DataSource source(unsized); },
                             InputError::Kind::kMalformed, "each side must be 1 to 65536 pixels",
                             0);
-  const Hdf5DataSource later(with_huge_image("later.h5", "images/image000000001"));
-  EXPECT_NO_THROW(later.ReadImage(0));
-  testing::ExpectInputError([&] { later.ReadImage(1); }, InputError::Kind::kSizeMismatch,
+  const std::string later = with_huge_image("later.h5", "images/image000000001");
+  testing::ExpectInputError([&] { Hdf5DataSource source(later); },
+                            InputError::Kind::kSizeMismatch,
                             "images/image000000001 is 64x4294967344", 0);
+}
+
+// Rewrites the root attribute sensor_resolution of `path` as [height, width].
+void DeclareSensorResolution(const std::string& path, int64_t height, int64_t width) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  if (H5Aexists(file, "sensor_resolution") > 0) H5Adelete(file, "sensor_resolution");
+  const hsize_t two = 2;
+  const int64_t resolution[2] = {height, width};
+  const hid_t space = H5Screate_simple(1, &two, nullptr);
+  const hid_t attribute = H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space,
+                                     H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(attribute, H5T_NATIVE_INT64, resolution);
+  H5Aclose(attribute);
+  H5Sclose(space);
+  H5Fclose(file);
+}
+
+// Regression (issue 14): a sensor_resolution of 65535x65535 over 64x48 frames was trusted until
+// a frame was read, and `evfs info --first` allocated for its 4 G pixels first (bad_alloc).
+// Declared sizes are checked against the frames and bounded when the file opens.
+TEST(Hdf5IoTest, DeclaredSensorSizeIsCheckedBeforeAllocating) {
+  const std::string dir = testing::ScratchDir("h5_declared_size");
+  const Recording recording = MakeRecording(5, 100);
+  const std::string framed = dir + "/framed.h5";
+  WriteHdf5(framed, recording.events, recording.frames, recording.images);
+  DeclareSensorResolution(framed, 65535, 65535);
+  testing::ExpectInputError([&] { Hdf5DataSource source(framed); },
+                            InputError::Kind::kOutOfRange, "65535x65535 sensor", 0);
+  // Within the bound, the frames must still have the declared size.
+  DeclareSensorResolution(framed, 4096, 8192);
+  testing::ExpectInputError([&] { Hdf5DataSource source(framed); },
+                            InputError::Kind::kSizeMismatch, "the sensor is 8192x4096", 0);
+  // Without frames, too: a size beyond any sensor is refused.
+  const std::string huge = dir + "/huge.h5";
+  WriteHdf5(huge, recording.events, {}, {});
+  DeclareSensorResolution(huge, 65535, 65535);
+  testing::ExpectInputError([&] { Hdf5DataSource source(huge); },
+                            InputError::Kind::kOutOfRange, "65535x65535 sensor", 0);
+  // A declared sensor larger than the events need, within the bound, is a sensor.
+  const std::string larger = dir + "/larger.h5";
+  WriteHdf5(larger, recording.events, {}, {});
+  DeclareSensorResolution(larger, 4096, 8192);
+  const Hdf5DataSource source(larger);
+  EXPECT_EQ(source.width(), 8192);
+  EXPECT_EQ(source.height(), 4096);
+  EXPECT_EQ(source.ReadAllEvents().size(), recording.events.size());
 }
 
 // The file the HDF5 fuzzer found it with: a contiguous image whose type reads as 0 bytes (so no

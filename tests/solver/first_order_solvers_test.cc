@@ -10,9 +10,9 @@
 
 #include "core/error.h"
 #include "core/metrics.h"
-#include "solver/event_model_estimation.h"
+#include "scene/event_model_estimation.h"
 #include "solver/problem_builder.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {

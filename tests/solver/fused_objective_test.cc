@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "solver/activity_mask.h"
+#include "scene/activity_mask.h"
 #include "solver/problem_builder.h"
 
 namespace evfs {

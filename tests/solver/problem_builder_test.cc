@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "tests/solver/solver_test_scenes.h"
+#include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {
@@ -169,6 +170,22 @@ TEST(ActivityMask, IndependentPartsAreConnectedRegionsOfTheProblem) {
   // Regions below the minimum size are packed into one part.
   EXPECT_EQ(mask.IndependentParts(41).size(), 1u);
   EXPECT_EQ(mask.IndependentParts(41).front().size(), 65u);
+}
+
+// Regression (issue 14): a radius of 2^31 - 239 or more overflowed int in the dilation and
+// crashed (SIGSEGV). Any radius beyond the sensor makes every pixel active, like the sensor size.
+TEST(ActivityMask, RadiusBeyondTheSensorMakesEveryPixelActive) {
+  const Scene scene = MakeSceneWithEvents(6, 18, {{0, 2, 2}});
+  const ActivityMask small(scene.events, 1);
+  EXPECT_EQ(small.num_active(), 9);
+  for (const int radius : {18, 1000, std::numeric_limits<int>::max() - 238,
+                           std::numeric_limits<int>::max()}) {
+    const ActivityMask mask(scene.events, radius);
+    EXPECT_EQ(mask.num_active(), 6 * 18) << radius;
+  }
+  // With no event nothing is active, whatever the radius.
+  const Scene quiet = MakeSceneWithEvents(6, 18, {});
+  EXPECT_EQ(ActivityMask(quiet.events, std::numeric_limits<int>::max()).num_active(), 0);
 }
 
 TEST(ProblemBuilder, PartsSplitTheWholeProblemExactly) {

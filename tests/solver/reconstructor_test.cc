@@ -5,8 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/metrics.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {
@@ -104,6 +105,27 @@ TEST(Reconstructor, ContinuationOnTheSmoothingScaleEndsOnTheObjectivesOwn) {
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_NE(error.find("smoothing_continuation"), std::string::npos) << error;
+}
+
+// A start Ceres cannot evaluate (NaN intensities) ends its solve with FAILURE: a solver
+// failure, not an invalid argument of the user's.
+TEST(Reconstructor, CeresFailureIsASolverError) {
+  const testing::SyntheticRecording recording;
+  const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                             recording.events, BinningOptions());
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  Video initial = InitializeLatentVideo(scene);
+  initial.frame(initial.num_frames() / 2).setConstant(std::nan(""));
+  try {
+    Reconstruct(scene, options, &initial);
+    ADD_FAILURE() << "the solve did not fail";
+  } catch (const SolverError& error) {
+    EXPECT_NE(std::string(error.what()).find("the solver failed: "), std::string::npos)
+        << error.what();
+  } catch (const std::exception& error) {
+    ADD_FAILURE() << "not a SolverError: " << error.what();
+  }
 }
 
 // Two shapes far apart on a wide sensor: two independent regions, each its own part.

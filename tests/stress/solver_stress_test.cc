@@ -7,8 +7,8 @@
 #include <string>
 #include <tuple>
 
-#include "solver/activity_mask.h"
-#include "solver/event_model_estimation.h"
+#include "scene/activity_mask.h"
+#include "scene/event_model_estimation.h"
 #include "solver/first_order_solvers.h"
 #include "solver/fused_objective.h"
 #include "tests/stress/stress_checks.h"

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/video.h"
-#include "solver/event_model_estimation.h"
+#include "scene/event_model_estimation.h"
 #include "solver/latent_layout.h"
 #include "solver/problem_builder.h"
 #include "solver/reconstruction_options.h"

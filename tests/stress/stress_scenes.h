@@ -14,10 +14,10 @@
 
 #include "core/event_stream.h"
 #include "core/video.h"
-#include "cost_functions/event_model.h"
+#include "scene/event_model.h"
 #include "events/random.h"
-#include "solver/scene.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "scene/scene.h"
+#include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace testing {

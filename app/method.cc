@@ -1,0 +1,180 @@
+#include "app/method.h"
+
+#include <chrono>
+
+#include "baselines/baseline.h"
+#include "core/error.h"
+#include "core/time.h"
+#include "core/metrics.h"
+#include "scene/activity_mask.h"
+#include "scene/scene.h"
+
+namespace evfs {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct MethodInfo {
+  Method method;
+  const char* name;
+};
+
+constexpr MethodInfo kMethods[] = {
+    {Method::kCeresLm, "ceres_lm"},
+    {Method::kCeresLbfgs, "ceres_lbfgs"},
+    {Method::kAdam, "adam"},
+    {Method::kAdamSmooth, "adam_smooth"},
+    {Method::kBlend, "blend"},
+    {Method::kCopy, "copy"},
+    {Method::kIntegrate, "integrate"},
+    {Method::kComplementaryFilter, "cf"},
+    {Method::kEdi, "edi"},
+};
+
+BaselineMethod AsBaseline(Method method) { return ParseBaseline(MethodName(method)); }
+
+// Wraps the caller's progress callback, recording a checkpoint per iteration when asked.
+IterationCallback Observer(const IterationCallback& progress, bool record_checkpoints,
+                           const CheckpointTruth* truth, std::vector<Checkpoint>* checkpoints) {
+  if (!record_checkpoints) return progress;
+  return [=](const SolverIteration& iteration) {
+    Checkpoint checkpoint;
+    checkpoint.iteration = iteration.iteration;
+    checkpoint.time_s = iteration.elapsed_s;
+    checkpoint.cost = iteration.cost;
+    if (truth != nullptr && truth->image != nullptr && iteration.latent != nullptr) {
+      const Image estimate = iteration.latent->frame(truth->latent_index);
+      checkpoint.psnr = Psnr(estimate, *truth->image);
+      checkpoint.ssim = Ssim(estimate, *truth->image);
+    }
+    checkpoints->push_back(checkpoint);
+    return progress ? progress(iteration) : true;
+  };
+}
+
+void RunCeresLm(const Scene& scene, const MethodOptions& options, const Video& initial,
+                const IterationCallback& observer, MethodResult* result) {
+  Reconstruction reconstruction =
+      Reconstruct(scene, options.reconstruction, &initial, observer);
+  const ReconstructionSummary& summary = reconstruction.summary;
+  result->video = std::move(reconstruction.video);
+  result->solved = summary.solved;
+  result->message = summary.solved ? summary.ceres.message : summary.skipped_reason;
+  result->iterations = summary.iterations;
+  result->initial_cost = summary.initial_cost;
+  result->final_cost = summary.final_cost;
+  result->build_time_s = summary.build_time_s;
+  result->solve_time_s = summary.solve_time_s;
+  result->reconstruction = summary;
+}
+
+void RunFirstOrder(const Scene& scene, const MethodOptions& options, const Video& initial,
+                   const IterationCallback& observer, MethodResult* result) {
+  ReconstructionSummary& summary = result->reconstruction;
+  const ObjectiveOptions objective = ResolveObjective(scene, options.reconstruction,
+                                                      &summary.model, &summary.alpha_derived);
+  result->video = initial;
+  if (scene.num_events == 0) {
+    result->message = "no events in the window: the initialisation is the answer";
+    summary.skipped_reason = result->message;
+    return;
+  }
+  const ActivityMask mask(scene.events, options.reconstruction.activity_radius_px);
+  FirstOrderSummary first_order;
+  if (options.method == Method::kCeresLbfgs) {
+    first_order = SolveWithLbfgs(scene, objective, mask, options.lbfgs, &result->video, observer);
+  } else {
+    AdamOptions adam = options.adam;
+    adam.penalty = options.method == Method::kAdam ? L1Penalty::kTrueL1 : L1Penalty::kSmoothed;
+    adam.bound_intensities = options.reconstruction.bound_intensities;
+    first_order = SolveWithAdam(scene, objective, mask, adam, &result->video, observer);
+    result->parameters = {{"learning_rate", adam.learning_rate},
+                          {"decay_every", static_cast<double>(adam.decay_every)},
+                          {"decay_factor", adam.decay_factor},
+                          {"beta1", adam.beta1},
+                          {"beta2", adam.beta2},
+                          {"max_iterations", static_cast<double>(adam.max_iterations)}};
+  }
+  result->solved = true;
+  result->message = first_order.termination;
+  result->iterations = first_order.iterations;
+  result->initial_cost = first_order.initial_cost;
+  result->final_cost = first_order.final_cost;
+  result->build_time_s = first_order.setup_time_s;
+  result->solve_time_s = first_order.solve_time_s;
+  summary.solved = true;
+  summary.iterations = first_order.iterations;
+  summary.initial_cost = first_order.initial_cost;
+  summary.final_cost = first_order.final_cost;
+  summary.problem.active_pixels = mask.num_active();
+  summary.problem.skipped_pixels = mask.num_pixels() - mask.num_active();
+  summary.problem.variable_parameter_blocks = first_order.active_voxels;
+}
+
+}  // namespace
+
+const char* MethodName(Method method) {
+  for (const MethodInfo& info : kMethods) {
+    if (info.method == method) return info.name;
+  }
+  return "unknown";
+}
+
+Method ParseMethod(const std::string& name) {
+  std::string names;
+  for (const MethodInfo& info : kMethods) {
+    if (name == info.name) return info.method;
+    names += names.empty() ? "" : ", ";
+    names += info.name;
+  }
+  throw InvalidArgumentError("unknown method '" + name + "' (one of " + names + ")");
+}
+
+std::vector<Method> AllMethods() {
+  std::vector<Method> methods;
+  for (const MethodInfo& info : kMethods) methods.push_back(info.method);
+  return methods;
+}
+
+bool IsIterative(Method method) {
+  return method == Method::kCeresLm || method == Method::kCeresLbfgs ||
+         method == Method::kAdam || method == Method::kAdamSmooth;
+}
+
+bool MethodSupports(Method method, const Scene& scene, std::string* why_not) {
+  if (IsIterative(method)) return true;
+  return BaselineSupports(AsBaseline(method), scene, why_not);
+}
+
+MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
+                       const IterationCallback& progress, bool record_checkpoints,
+                       const CheckpointTruth* truth) {
+  MethodResult result;
+  result.method = MethodName(options.method);
+  if (!IsIterative(options.method)) {
+    const auto start = Clock::now();
+    BaselineResult baseline = RunBaseline(AsBaseline(options.method), scene, options.baseline);
+    result.solve_time_s = SecondsSince(start);
+    result.video = std::move(baseline.video);
+    result.parameters = std::move(baseline.parameters);
+    result.threshold_source = std::move(baseline.threshold_source);
+    result.message = "closed form";
+    return result;
+  }
+  if (truth != nullptr && (truth->image == nullptr || truth->latent_index < 0 ||
+                           truth->latent_index >= scene.num_latent_frames())) {
+    throw InvalidArgumentError("checkpoint truth: no image or a latent index off the timeline");
+  }
+  const Video initial =
+      InitialLatentVideo(scene, options.initialization, options.baseline, &result.initialization);
+  const IterationCallback observer =
+      Observer(progress, record_checkpoints, truth, &result.checkpoints);
+  if (options.method == Method::kCeresLm) {
+    RunCeresLm(scene, options, initial, observer, &result);
+  } else {
+    RunFirstOrder(scene, options, initial, observer, &result);
+  }
+  return result;
+}
+
+}  // namespace evfs

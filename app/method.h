@@ -1,0 +1,108 @@
+// Every reconstruction method of evfs behind one call, so that the command line, the demo and the
+// benchmarks run any of them on the same Scene and report them the same way:
+//
+//   ceres_lm     the default: Levenberg–Marquardt on the Ceres residual-block problem
+//   ceres_lbfgs  Ceres' L-BFGS on the fused evaluation of the same (smoothed) objective
+//   adam         the paper's optimiser and schedule on the paper's true-ℓ1 objective
+//   adam_smooth  the same schedule on the smoothed objective Ceres minimises
+//   blend, copy, integrate, cf, edi   the classical baselines of baselines/
+#ifndef EVFS_APP_METHOD_H_
+#define EVFS_APP_METHOD_H_
+
+#include <string>
+#include <vector>
+
+#include "baselines/baseline.h"
+#include "baselines/baseline_options.h"
+#include "core/video.h"
+#include "app/initialization.h"
+#include "solver/first_order_solvers.h"
+#include "solver/iteration_callback.h"
+#include "solver/reconstruction_options.h"
+#include "solver/reconstructor.h"
+#include "scene/scene.h"
+
+namespace evfs {
+
+enum class Method {
+  kCeresLm,
+  kCeresLbfgs,
+  kAdam,
+  kAdamSmooth,
+  kBlend,
+  kCopy,
+  kIntegrate,
+  kComplementaryFilter,
+  kEdi,
+};
+
+/// "ceres_lm", "ceres_lbfgs", "adam", "adam_smooth", "blend", "copy", "integrate", "cf", "edi".
+const char* MethodName(Method method);
+/// The inverse of MethodName; throws InvalidArgumentError for another name, listing them.
+Method ParseMethod(const std::string& name);
+/// Every method, in the order above.
+std::vector<Method> AllMethods();
+/// True for the solvers of the objective (the first four), false for the classical baselines.
+bool IsIterative(Method method);
+/// True when `method` can reconstruct `scene` (baselines support only some cases); otherwise
+/// false with the reason in `why_not` (may be null).
+bool MethodSupports(Method method, const Scene& scene, std::string* why_not);
+
+struct MethodOptions {
+  Method method = Method::kCeresLm;
+  /// The objective, α's derivation, skipping and the Ceres LM settings (all iterative methods
+  /// read the objective, the skipping and the bounds from here).
+  ReconstructionOptions reconstruction;
+  AdamOptions adam;
+  LbfgsOptions lbfgs;
+  /// The classical methods' parameters; also those of the events initialisation.
+  BaselineOptions baseline;
+  /// Where the iterative methods start.
+  Initialization initialization = Initialization::kBlend;
+};
+
+/// One point of an iterative solve: cost, and quality when a truth frame was given.
+struct Checkpoint {
+  int iteration = 0;
+  double time_s = 0.0;  // solve time so far, without the time taken by the checkpoints
+  double cost = 0.0;
+  double psnr = 0.0;  // 0 without a truth frame
+  double ssim = 0.0;
+};
+
+/// A frame to score checkpoints against: `image` at latent frame `latent_index`.
+struct CheckpointTruth {
+  const Image* image = nullptr;
+  int latent_index = -1;
+};
+
+struct MethodResult {
+  Video video;  // on the scene's latent timeline
+  std::string method;
+  std::string initialization;  // iterative methods: what they started from
+  bool solved = false;         // an iterative solve ran
+  std::string message;         // why it stopped, or why it did not run
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+  double build_time_s = 0.0;  // problem construction / objective set-up
+  double solve_time_s = 0.0;  // the solve (or the baseline), without checkpoints and callback
+  /// The Ceres LM summary (ceres_lm), or the α and skipping statistics of any iterative method.
+  ReconstructionSummary reconstruction;
+  /// Named numeric parameters the method used (baselines: thresholds; Adam: schedule …).
+  std::vector<BaselineParameter> parameters;
+  std::string threshold_source;  // baselines: how the contrast threshold was chosen
+  std::vector<Checkpoint> checkpoints;
+};
+
+/// Runs `options.method` on `scene`. `progress` (may be empty) sees every iteration of an
+/// iterative method. With `truth` (may be null) and `record_checkpoints`, every iteration's
+/// cost, PSNR and SSIM are recorded. Throws InvalidArgumentError for invalid options or a scene
+/// the method does not support.
+MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
+                       const IterationCallback& progress = nullptr,
+                       bool record_checkpoints = false,
+                       const CheckpointTruth* truth = nullptr);
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_METHOD_H_

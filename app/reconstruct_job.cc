@@ -1,0 +1,405 @@
+#include "app/reconstruct_job.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/time.h"
+#include "app/json_writer.h"
+#include "io/data_source.h"
+#include "io/image_io.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Most frames --fps may resample the latent video to (a runaway rate would fill memory).
+constexpr double kMaxOutputFrames = 10000;
+// Longest --exposure_s: keeps t +- exposure / 2 far inside int64 nanoseconds.
+constexpr double kMaxExposureS = 3600.0;
+
+void CheckFrameIndex(const DataSource& source, int index, const char* what) {
+  const int count = static_cast<int>(source.frames().size());
+  if (count == 0) {
+    throw InvalidArgumentError(source.path() + " has 0 frames (" + source.no_frames_reason() +
+                               "): a reconstruction needs the frames it starts from");
+  }
+  if (index < 0 || index >= count) {
+    throw InvalidArgumentError(std::string(what) + " frame " + std::to_string(index) +
+                               " is out of range: " + source.path() + " has " +
+                               std::to_string(count) + " frames (0.." +
+                               std::to_string(count - 1) + ")");
+  }
+}
+
+TimedFrame ReadSharpFrame(const DataSource& source, int index) {
+  TimedFrame frame;
+  frame.image = source.ReadImage(index);
+  frame.exposure_begin_ns = frame.exposure_end_ns = source.frames()[index].t_ns;
+  frame.label = source.frames()[index].path;
+  return frame;
+}
+
+TimedFrame ReadBlurredFrame(const DataSource& source, int index, double exposure_s) {
+  const FrameInfo& info = source.frames()[index];
+  TimedFrame frame;
+  frame.label = info.path;
+  if (info.has_exposure) {
+    frame.exposure_begin_ns = info.exposure_begin_ns;
+    frame.exposure_end_ns = info.exposure_end_ns;
+  } else if (exposure_s > 0.0) {
+    const int64_t half_ns = SecondsToNanoseconds(exposure_s / 2.0);
+    frame.exposure_begin_ns = info.t_ns - half_ns;
+    frame.exposure_end_ns = info.t_ns + half_ns;
+  } else {
+    throw InvalidArgumentError("deblur needs the exposure of " + info.path +
+                               ": the data has no exposures.txt entry for it; pass --exposure_s");
+  }
+  frame.image = source.ReadImage(index);
+  return frame;
+}
+
+Video Resample(const Video& latent, double fps) {
+  const int64_t begin_ns = latent.timestamp_ns(0);
+  const int64_t end_ns = latent.timestamp_ns(latent.num_frames() - 1);
+  const double step_ns = static_cast<double>(kNanosecondsPerSecond) / fps;  // inf for tiny fps
+  // The frame count is bounded in double before any i · step_ns is rounded to int64: a tiny
+  // --fps made that product wrap and the loop run forever, allocating.
+  const double last_index =
+      std::floor((static_cast<double>(end_ns - begin_ns) + 0.5) / step_ns);
+  Video output;
+  for (int64_t i = 0; i <= last_index; ++i) {
+    const int64_t t_ns =
+        begin_ns + (i == 0 ? 0 : static_cast<int64_t>(std::llround(i * step_ns)));
+    if (t_ns > end_ns) break;
+    output.AppendFrame(latent.InterpolateAt(t_ns), t_ns);
+  }
+  return output;
+}
+
+}  // namespace
+
+Mode ParseMode(const std::string& name) {
+  if (name == "interpolate") return Mode::kInterpolate;
+  if (name == "predict") return Mode::kPredict;
+  if (name == "deblur") return Mode::kDeblur;
+  throw InvalidArgumentError("unknown mode '" + name +
+                             "': expected interpolate, predict or deblur");
+}
+
+const char* ModeName(Mode mode) {
+  switch (mode) {
+    case Mode::kInterpolate:
+      return "interpolate";
+    case Mode::kPredict:
+      return "predict";
+    case Mode::kDeblur:
+      return "deblur";
+  }
+  return "";
+}
+
+ReconstructResult RunReconstruction(const ReconstructRequest& request) {
+  const auto total_start = Clock::now();
+  std::string error;
+  if (!request.method.reconstruction.IsValid(&error)) {
+    throw InvalidArgumentError("invalid options: " + error);
+  }
+  if (!request.binning.IsValid(&error)) throw InvalidArgumentError("invalid binning: " + error);
+  if (request.fps < 0.0 || !std::isfinite(request.fps)) {
+    throw InvalidArgumentError("--fps must be positive (or 0 for the latent timeline)");
+  }
+  if (!(request.exposure_s >= 0.0 && request.exposure_s <= kMaxExposureS)) {
+    throw InvalidArgumentError("--exposure_s must be between 0 and " +
+                               std::to_string(static_cast<int>(kMaxExposureS)) + " seconds");
+  }
+
+  ReconstructResult result;
+  result.mode = request.mode;
+  const auto stage = [&request](const char* name) {
+    if (request.stage) request.stage(name);
+  };
+  stage("read");
+  const auto read_start = Clock::now();
+  const std::unique_ptr<DataSource> source = DataSource::Open(request.data_path);
+  result.width = source->width();
+  result.height = source->height();
+  CheckFrameIndex(*source, request.first, "the first");
+  const int last = request.last >= 0 ? request.last : request.first + 1;
+  if (request.mode != Mode::kDeblur) {
+    CheckFrameIndex(*source, last, "the last");
+    if (last <= request.first) {
+      throw InvalidArgumentError("--last (" + std::to_string(last) +
+                                 ") must come after --first (" + std::to_string(request.first) +
+                                 ")");
+    }
+  }
+  if (request.truth >= 0) CheckFrameIndex(*source, request.truth, "the truth");
+
+  std::vector<TimedFrame> frames;
+  int64_t window_begin_ns = 0, window_end_ns = 0;
+  switch (request.mode) {
+    case Mode::kInterpolate:
+      frames = {ReadSharpFrame(*source, request.first), ReadSharpFrame(*source, last)};
+      window_begin_ns = frames.front().exposure_begin_ns;
+      window_end_ns = frames.back().exposure_end_ns;
+      break;
+    case Mode::kPredict:
+      frames = {ReadSharpFrame(*source, request.first)};
+      window_begin_ns = frames.front().exposure_begin_ns;
+      window_end_ns = source->frames()[last].t_ns;
+      break;
+    case Mode::kDeblur:
+      frames = {ReadBlurredFrame(*source, request.first, request.exposure_s)};
+      window_begin_ns = frames.front().exposure_begin_ns;
+      window_end_ns = frames.front().exposure_end_ns;
+      break;
+  }
+  const double window_s = NanosecondsToSeconds(window_end_ns - window_begin_ns);
+  if (request.fps * window_s > kMaxOutputFrames) {
+    throw InvalidArgumentError("--fps would resample the " + std::to_string(window_s) +
+                               " s window to more than " +
+                               std::to_string(static_cast<int>(kMaxOutputFrames)) + " frames");
+  }
+  const EventStream events = source->ReadEvents(window_begin_ns, window_end_ns);
+  Image truth_image;
+  if (request.truth >= 0) truth_image = source->ReadImage(request.truth);
+  result.time.read_s = SecondsSince(read_start);
+
+  stage("bin");
+  const auto bin_start = Clock::now();
+  const Scene scene = MakeScene(frames, events, window_begin_ns, window_end_ns, request.binning);
+  result.events = scene.num_events;
+  result.event_frames = scene.events.num_frames();
+  result.hot_pixels = static_cast<int>(scene.hot_pixels.size());
+  result.hot_pixel_events = scene.hot_pixel_events;
+  result.time.bin_s = SecondsSince(bin_start);
+
+  result.baseline = InitializeLatentVideo(scene);
+  CheckpointTruth checkpoint_truth;
+  const bool score = request.truth >= 0;
+  if (score) {
+    result.truth.timestamp_ns = source->frames()[request.truth].t_ns;
+    if (result.truth.timestamp_ns < window_begin_ns || result.truth.timestamp_ns > window_end_ns) {
+      throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
+                                 " lies outside the reconstructed window");
+    }
+    checkpoint_truth.image = &truth_image;
+    checkpoint_truth.latent_index = result.baseline.NearestFrame(result.truth.timestamp_ns);
+  }
+  std::string why_not;
+  if (!MethodSupports(request.method.method, scene, &why_not)) {
+    throw InvalidArgumentError(std::string("--solver=") + MethodName(request.method.method) +
+                               " cannot reconstruct this case: " + why_not);
+  }
+  stage(request.progress ? "build" : "build and solve");
+  result.run = RunMethod(scene, request.method, request.progress, request.checkpoints,
+                         score ? &checkpoint_truth : nullptr);
+  result.time.build_s = result.run.build_time_s;
+  result.time.solve_s = result.run.solve_time_s;
+  const Video& latent = result.run.video;
+  result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
+
+  if (request.truth >= 0) {
+    TruthScore& truth = result.truth;
+    truth.index = request.truth;
+    truth.latent_index = latent.NearestFrame(truth.timestamp_ns);
+    const Image estimate = latent.frame(truth.latent_index);
+    truth.psnr = Psnr(estimate, truth_image);
+    truth.ssim = Ssim(estimate, truth_image);
+    const Image baseline = result.baseline.frame(truth.latent_index);
+    truth.baseline_psnr = Psnr(baseline, truth_image);
+    truth.baseline_ssim = Ssim(baseline, truth_image);
+    result.has_truth = true;
+  }
+  result.time.total_s = SecondsSince(total_start);
+  return result;
+}
+
+namespace {
+
+void WriteCeresLm(const ReconstructionOptions& options, const ReconstructionSummary& summary,
+                  JsonWriter* json) {
+  json->Field("linear_solver", ceres::LinearSolverTypeToString(options.solver.linear_solver_type));
+  json->Field("preconditioner",
+              ceres::PreconditionerTypeToString(options.solver.preconditioner_type));
+  json->Field("eta", options.solver.eta);
+  json->Field("max_iterations", options.solver.max_num_iterations);
+  json->Field("function_tolerance", options.solver.function_tolerance);
+  json->Field("threads", options.solver.num_threads);
+  if (!summary.solved) return;
+  json->Field("termination", ceres::TerminationTypeToString(summary.ceres.termination_type));
+  // Where Ceres' time went (its own accounting).
+  json->Key("time_s").BeginObject();
+  json->Field("preprocessor", summary.ceres.preprocessor_time_in_seconds);
+  json->Field("residual_evaluation", summary.ceres.residual_evaluation_time_in_seconds);
+  json->Field("jacobian_evaluation", summary.ceres.jacobian_evaluation_time_in_seconds);
+  json->Field("linear_solver", summary.ceres.linear_solver_time_in_seconds);
+  json->Field("minimizer", summary.ceres.minimizer_time_in_seconds);
+  json->EndObject();
+  json->Field("successful_steps", summary.ceres.num_successful_steps);
+  json->Field("unsuccessful_steps", summary.ceres.num_unsuccessful_steps);
+}
+
+void WriteModel(const ObjectiveOptions& objective, const ReconstructionSummary& summary,
+                JsonWriter* json) {
+  json->Key("model").BeginObject();
+  json->Field("event_model", EventModelName(objective.event_model.model));
+  json->Field("alpha", summary.model.alpha);
+  json->Field("alpha_derived", summary.alpha_derived);
+  if (summary.alpha_derived) {
+    json->Field("change_per_event", summary.model.change_per_event);
+    json->Field("change_measured_from_frames", summary.model.estimated_from_frames);
+  }
+  json->Field("frame_weight", objective.frame_weight);
+  json->Field("event_weight", objective.event_weight);
+  json->Field("spatial_tv_weight", objective.spatial_tv_weight);
+  json->Field("temporal_tv_weight", objective.temporal_tv_weight);
+  json->Field("spatial_tv", SpatialTvName(objective.spatial_tv));
+  json->Field("smoothing_scale", objective.smoothing_scale);
+  json->EndObject();
+}
+
+void WriteProblem(const ReconstructionOptions& options, const ProblemStatistics& problem,
+                  JsonWriter* json) {
+  json->Key("pixels").BeginObject();
+  json->Field("active", problem.active_pixels);
+  json->Field("skipped", problem.skipped_pixels);
+  json->Field("activity_radius_px", options.activity_radius_px);
+  json->Field("merge_quiet_steps", options.merge_quiet_steps);
+  json->EndObject();
+  json->Key("problem").BeginObject();
+  json->Field("independent_parts", problem.parts);
+  json->Field("split_independent_parts", options.split_independent_parts);
+  json->Key("smoothing_continuation").BeginArray();
+  for (const double scale : options.smoothing_continuation) json->Element(scale);
+  json->EndArray();
+  json->Field("parameter_blocks", problem.parameter_blocks);
+  json->Field("unknowns", problem.variable_parameter_blocks);
+  json->Field("residual_blocks", problem.residual_blocks());
+  json->Field("frame_residuals", problem.frame_residuals);
+  json->Field("event_residuals", problem.event_residuals);
+  json->Field("spatial_tv_residuals", problem.spatial_tv_residuals);
+  json->Field("temporal_tv_residuals", problem.temporal_tv_residuals);
+  json->EndObject();
+}
+
+}  // namespace
+
+std::string SummaryJson(const ReconstructRequest& request, const ReconstructResult& result) {
+  const MethodResult& run = result.run;
+  const ReconstructionSummary& summary = run.reconstruction;
+  const ReconstructionOptions& options = request.method.reconstruction;
+  const bool iterative = IsIterative(request.method.method);
+  JsonWriter json;
+  json.BeginObject();
+  json.Field("mode", ModeName(result.mode));
+  json.Field("data", request.data_label.empty() ? request.data_path : request.data_label);
+  json.Field("width", result.width);
+  json.Field("height", result.height);
+  json.Field("events", result.events);
+  json.Field("hot_pixels", result.hot_pixels);
+  json.Field("hot_pixel_events", result.hot_pixel_events);
+  json.Field("event_frames", result.event_frames);
+  json.Field("latent_frames", run.video.num_frames());
+  json.Field("output_frames", result.output.num_frames());
+  json.Key("solver").BeginObject();
+  json.Field("name", run.method);
+  json.Field("message", run.message);
+  if (iterative) {
+    json.Field("initialization", run.initialization);
+    json.Field("bounds", options.bound_intensities);
+  }
+  if (request.method.method == Method::kCeresLm) WriteCeresLm(options, summary, &json);
+  if (!run.parameters.empty()) {
+    json.Key("parameters").BeginObject();
+    for (const BaselineParameter& parameter : run.parameters) {
+      json.Field(parameter.name.c_str(), parameter.value);
+    }
+    json.EndObject();
+  }
+  if (!run.threshold_source.empty()) json.Field("threshold_source", run.threshold_source);
+  json.EndObject();
+  if (iterative) {
+    WriteModel(options.objective, summary, &json);
+    json.Field("solved", run.solved);
+    json.Field("iterations", run.iterations);
+    json.Field("initial_cost", run.initial_cost);
+    json.Field("final_cost", run.final_cost);
+    WriteProblem(options, summary.problem, &json);
+  }
+  json.Key("time_s").BeginObject();
+  json.Field("read", result.time.read_s);
+  json.Field("bin", result.time.bin_s);
+  json.Field("build", result.time.build_s);
+  json.Field("solve", result.time.solve_s);
+  json.Field("write", result.time.write_s);
+  json.Field("total", result.time.total_s);
+  json.EndObject();
+  if (result.has_truth) {
+    const TruthScore& truth = result.truth;
+    json.Key("truth").BeginObject();
+    json.Field("index", truth.index);
+    json.Field("timestamp_s", NanosecondsToSeconds(truth.timestamp_ns));
+    json.Field("latent_index", truth.latent_index);
+    json.Field("psnr", truth.psnr);
+    json.Field("ssim", truth.ssim);
+    json.Field("baseline", result.mode == Mode::kInterpolate ? "blend" : "copy");
+    json.Field("baseline_psnr", truth.baseline_psnr);
+    json.Field("baseline_ssim", truth.baseline_ssim);
+    json.EndObject();
+  }
+  if (!run.checkpoints.empty()) {
+    json.Key("checkpoints").BeginArray();
+    for (const Checkpoint& checkpoint : run.checkpoints) {
+      json.BeginObject();
+      json.Field("iteration", checkpoint.iteration);
+      json.Field("time_s", checkpoint.time_s);
+      json.Field("cost", checkpoint.cost);
+      if (result.has_truth) {
+        json.Field("psnr", checkpoint.psnr);
+        json.Field("ssim", checkpoint.ssim);
+      }
+      json.EndObject();
+    }
+    json.EndArray();
+  }
+  json.EndObject();
+  return json.str();
+}
+
+void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
+                         const std::string& folder) {
+  const auto write_start = Clock::now();
+  const fs::path out(folder);
+  std::error_code ec;
+  fs::create_directories(out / "frames", ec);
+  if (ec) {
+    throw InputError(InputError::Kind::kUnwritable, out.string(), 0,
+                     "cannot create the output folder (" + ec.message() + ")");
+  }
+  char name[32];
+  for (int t = 0; t < result->output.num_frames(); ++t) {
+    std::snprintf(name, sizeof(name), "%06d.png", t);
+    WriteGreyPng16((out / "frames" / name).string(), result->output.frame(t));
+  }
+  WriteTimestampsTxt((out / "timestamps.txt").string(), result->output.timestamps_ns());
+  result->time.write_s = SecondsSince(write_start);
+  result->time.total_s += result->time.write_s;
+  std::ofstream summary(out / "summary.json");
+  summary << SummaryJson(request, *result) << "\n";
+  summary.close();
+  if (!summary) {
+    throw InputError(InputError::Kind::kUnwritable, (out / "summary.json").string(), 0,
+                     "cannot write the summary");
+  }
+}
+
+}  // namespace evfs

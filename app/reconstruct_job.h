@@ -1,0 +1,87 @@
+// One reconstruction job as the CLI, the demo and the benchmarks run it: read a recording,
+// build the scene for the requested case, derive α, solve, score against a truth frame and
+// write the results. Options arrive filled in; nothing here reads a flag.
+#ifndef EVFS_APP_RECONSTRUCT_JOB_H_
+#define EVFS_APP_RECONSTRUCT_JOB_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "core/video.h"
+#include "app/method.h"
+#include "scene/scene.h"
+
+namespace evfs {
+
+enum class Mode { kInterpolate, kPredict, kDeblur };
+
+/// "interpolate", "predict", "deblur" → Mode; throws InvalidArgumentError otherwise.
+Mode ParseMode(const std::string& name);
+const char* ModeName(Mode mode);
+
+struct ReconstructRequest {
+  std::string data_path;   // data folder or HDF5 file
+  std::string data_label;  // how summary.json names the data ("": data_path)
+  Mode mode = Mode::kPredict;
+  int first = 0;    // images.txt line (0-based) of the first / blurred frame
+  int last = -1;    // interpolate: the last frame; predict: the frame whose time ends the window
+                    // (-1: first + 1)
+  int truth = -1;   // frame to score against (-1: none)
+  double exposure_s = 0.0;  // deblur: exposure around the frame's timestamp when the data has none
+  double fps = 0.0;         // > 0: resample the latent video to this uniform rate
+  BinningOptions binning;
+  /// The method and all its settings (objective.event_model.alpha <= 0: derive α from the data).
+  MethodOptions method;
+  /// Record cost (and PSNR/SSIM against --truth) at every iteration into summary.json.
+  bool checkpoints = false;
+  /// Sees every iteration of an iterative method (progress output); may be empty.
+  IterationCallback progress;
+  /// Told each stage as the job reaches it: "read", "bin", then "build" (with `progress`: the
+  /// iterations say when the solve starts) or "build and solve"; may be empty.
+  std::function<void(const char* stage)> stage;
+};
+
+struct TruthScore {
+  int index = -1;            // images.txt line of the truth frame
+  int64_t timestamp_ns = 0;  // its timestamp
+  int latent_index = -1;     // latent frame nearest to it
+  double psnr = 0.0, ssim = 0.0;                    // reconstruction against truth
+  double baseline_psnr = 0.0, baseline_ssim = 0.0;  // initialisation (blend or copy) against truth
+};
+
+struct StageTimes {
+  double read_s = 0.0, bin_s = 0.0, build_s = 0.0, solve_s = 0.0, write_s = 0.0, total_s = 0.0;
+};
+
+struct ReconstructResult {
+  Mode mode = Mode::kPredict;
+  int width = 0, height = 0;
+  int64_t events = 0;  // events in the window (binned; hot pixels' left out)
+  int event_frames = 0;
+  int hot_pixels = 0;             // pixels whose events were left out as hot (BinningOptions)
+  int64_t hot_pixel_events = 0;   // their events
+  MethodResult run;               // latent video and what the method did
+  Video output;                   // the latent video, or its resampling at request.fps
+  Video baseline;                 // blend or copy on the latent timeline (the score's reference)
+  bool has_truth = false;
+  TruthScore truth;
+  StageTimes time;
+};
+
+/// Runs the job. Throws evfs::Error (InputError, InvalidArgumentError) on bad input.
+ReconstructResult RunReconstruction(const ReconstructRequest& request);
+
+/// Writes `folder`/frames/NNNNNN.png (16-bit grey), timestamps.txt and summary.json into a new
+/// or empty folder: the staging folder of an OutputTarget (io/output_target.h), which makes the
+/// output appear whole or not at all. Fills result->time.write_s and total_s before writing the
+/// summary.
+void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
+                         const std::string& folder);
+
+/// summary.json's text (DESIGN.md §8).
+std::string SummaryJson(const ReconstructRequest& request, const ReconstructResult& result);
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_RECONSTRUCT_JOB_H_

@@ -1,0 +1,41 @@
+# The `layering` test: every #include "module/..." of every source under a module folder must be
+# an edge of cmake/layers.txt. Run as
+#   cmake -DSOURCE_DIR=<repository root> -P cmake/CheckLayering.cmake
+# Prints each forbidden edge (file, line, included header) and fails when there is one.
+cmake_minimum_required(VERSION 3.18)
+if(NOT SOURCE_DIR)
+  message(FATAL_ERROR "CheckLayering.cmake needs -DSOURCE_DIR=<repository root>")
+endif()
+include("${CMAKE_CURRENT_LIST_DIR}/EvfsLayers.cmake")
+evfs_read_layers("${SOURCE_DIR}/cmake/layers.txt" modules)
+
+set(violations 0)
+set(checked 0)
+foreach(module IN LISTS modules)
+  set(allowed ${module} ${EVFS_LAYER_${module}})
+  file(GLOB_RECURSE sources "${SOURCE_DIR}/${module}/*.h" "${SOURCE_DIR}/${module}/*.cc")
+  foreach(source IN LISTS sources)
+    file(STRINGS "${source}" includes REGEX "^[ \t]*#[ \t]*include[ \t]*\"")
+    foreach(line IN LISTS includes)
+      string(REGEX MATCH "\"([^\"/]+)/[^\"]*\"" header "${line}")
+      if(NOT header)
+        continue()
+      endif()
+      set(target_module "${CMAKE_MATCH_1}")
+      math(EXPR checked "${checked} + 1")
+      if(NOT target_module IN_LIST modules)
+        continue()  # a path of the module's own (generated headers, data), not another module
+      endif()
+      if(NOT target_module IN_LIST allowed)
+        file(RELATIVE_PATH relative "${SOURCE_DIR}" "${source}")
+        message("${relative}: ${module} may not include ${header} (cmake/layers.txt: "
+                "${module}: ${EVFS_LAYER_${module}})")
+        math(EXPR violations "${violations} + 1")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+if(violations GREATER 0)
+  message(FATAL_ERROR "${violations} includes cross the layers of cmake/layers.txt")
+endif()
+message(STATUS "layering: ${checked} includes between modules follow cmake/layers.txt")

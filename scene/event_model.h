@@ -1,0 +1,97 @@
+// The differentiable event model, one latent step at a time:
+//   B(H_s, H_{s+1}) = tanh(alpha * (g(H_{s+1}) - g(H_s)))
+// with g(x) = x (the paper's model, its Eq. 2) or g(x) = log(x + b) (the sensor's log-intensity
+// contrast of its Eq. 1, where an event fires when log(I_t + b) - log(I_0 + b) passes a
+// threshold).
+#ifndef EVFS_SCENE_EVENT_MODEL_H_
+#define EVFS_SCENE_EVENT_MODEL_H_
+
+#include <glog/logging.h>
+
+#include <cmath>
+#include <string>
+
+namespace evfs {
+
+/// Which intensity transform g the event model compares between latent frames.
+enum class EventModel {
+  kLinear,  ///< g(x) = x   (paper Eq. 2)
+  kLog,     ///< g(x) = log(x + b)   (paper Eq. 1)
+};
+
+/// Parameters of the event model.
+struct EventModelParams {
+  EventModel model = EventModel::kLinear;  ///< the intensity transform g
+  double alpha = 5.0;                      ///< slope of the tanh activation (paper Eq. 2), > 0
+  double log_offset = 0.1;                 ///< b in log(x + b) (paper Eq. 1), > 0; kLog only
+
+  /// True when alpha > 0 and, for kLog, log_offset > 0; otherwise false with the reason in
+  /// `*error` (when not null).
+  bool IsValid(std::string* error) const {
+    std::string reason;
+    if (!(alpha > 0.0)) {
+      reason = "event model alpha must be > 0, got " + std::to_string(alpha);
+    } else if (model == EventModel::kLog && !(log_offset > 0.0)) {
+      reason = "log event model offset b must be > 0, got " + std::to_string(log_offset);
+    }
+    if (error != nullptr) *error = reason;
+    return reason.empty();
+  }
+};
+
+/// CHECKs `params.IsValid`: the residuals are built from options that were validated already,
+/// so invalid parameters there are a programmer error.
+inline void CheckEventModelParams(const EventModelParams& params) {
+  std::string error;
+  CHECK(params.IsValid(&error)) << error;
+}
+
+/// g(x): x for EventModel::kLinear, log(max(x, 0) + b) for EventModel::kLog.
+///
+/// The clamp at 0 is a guard for the optimiser stepping below 0 when intensities are not
+/// bounded to [0, 1]: log(x + b) would be NaN for x < -b and poison the whole solve. Below 0 the
+/// transform is flat (zero derivative), so such a step is neither rewarded nor fatal. At exactly
+/// 0 the derivative is the right-hand one, 1/b: a bounded solve holds black pixels at 0 (a black
+/// first frame is copied to every latent frame), and a derivative of 0 there would leave the
+/// event term no gradient to brighten them with.
+template <typename T>
+T IntensityTransform(const T& intensity, const EventModelParams& params) {
+  if (params.model == EventModel::kLinear) return intensity;
+  using std::log;
+  const T clamped_intensity = intensity >= T(0.0) ? intensity : T(0.0);
+  return log(clamped_intensity + params.log_offset);
+}
+
+/// dg/dx, matching IntensityTransform (0 below the clamp, 1/b at 0), for hand-written Jacobians.
+inline double IntensityTransformDerivative(double intensity, const EventModelParams& params) {
+  if (params.model == EventModel::kLinear) return 1.0;
+  return intensity >= 0.0 ? 1.0 / (intensity + params.log_offset) : 0.0;
+}
+
+/// Predicted event value of one latent step: c tanh(alpha (g(after) - g(before)) / c).
+///
+/// c = 1 is the paper's model (Eq. 2): a collision-binned step holds at most one event. A step
+/// of a stacked event frame (Binning 2) holds a signed count, which tanh cannot reach; the
+/// paper sums several sub-steps instead, at the price of more latent frames. With c = the
+/// count per step the curve keeps the paper's slope alpha at 0 and saturates at the count, so
+/// one latent step can explain it (SaturationForCount).
+template <typename T>
+T PredictedEvent(const T& intensity_before, const T& intensity_after,
+                 const EventModelParams& params, double saturation = 1.0) {
+  using std::tanh;
+  return saturation * tanh(params.alpha *
+                           (IntensityTransform(intensity_after, params) -
+                            IntensityTransform(intensity_before, params)) /
+                           saturation);
+}
+
+/// c of PredictedEvent for an event frame holding `event_value` over `num_steps` steps: at
+/// least 1 (the paper's model for collision frames and zero counts), else the count per step.
+inline double SaturationForCount(double event_value, int num_steps) {
+  const double per_step = (event_value < 0.0 ? -event_value : event_value) / num_steps;
+  return per_step > 1.0 ? per_step : 1.0;
+}
+
+}  // namespace evfs
+
+#endif  // EVFS_SCENE_EVENT_MODEL_H_

@@ -1,0 +1,98 @@
+#include "scene/event_model_estimation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+
+namespace evfs {
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// Net signed event count per pixel over the latent steps [first, last).
+std::vector<double> NetEventCount(const Scene& scene, int first, int last) {
+  std::vector<double> net(static_cast<size_t>(scene.height) * scene.width, 0.0);
+  for (int k = 0; k < scene.events.num_frames(); ++k) {
+    const EventFrameSpan& span = scene.events.span(k);
+    if (span.latent_first < first || span.latent_last > last) continue;
+    const float* values = scene.events.frame_data(k);
+    for (size_t p = 0; p < net.size(); ++p) net[p] += values[p];
+  }
+  return net;
+}
+
+}  // namespace
+
+bool EventModelEstimationOptions::IsValid(std::string* error) const {
+  if (!(alpha_times_change > 0.0) || !(assumed_contrast_threshold > 0.0) ||
+      !(assumed_linear_change > 0.0) ||
+      min_pixels < 1) {
+    if (error) *error = "event model estimation options must be positive";
+    return false;
+  }
+  return true;
+}
+
+EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams& model,
+                                      const EventModelEstimationOptions& options) {
+  EventModelEstimate estimate;
+
+  // The first and last sharp frames, if they are distinct, bracket the events between them:
+  // the change of g per net event there is what one event stands for, measured directly.
+  const FrameObservation* first = nullptr;
+  const FrameObservation* last = nullptr;
+  for (const FrameObservation& frame : scene.frames) {
+    if (frame.latent_first != frame.latent_last) continue;
+    if (!first || frame.latent_first < first->latent_first) first = &frame;
+    if (!last || frame.latent_first > last->latent_first) last = &frame;
+  }
+  int pixels_used = 0;
+  double change = 0.0;
+  if (first && last && first->latent_first < last->latent_first) {
+    const std::vector<double> net = NetEventCount(scene, first->latent_first, last->latent_first);
+    std::vector<double> per_event;
+    for (size_t p = 0; p < net.size(); ++p) {
+      if (net[p] == 0.0) continue;
+      const double frame_change = IntensityTransform(last->image.data()[p], model) -
+                                  IntensityTransform(first->image.data()[p], model);
+      if (frame_change * net[p] <= 0.0) continue;  // frames and events disagree: noise, occlusion
+      per_event.push_back(frame_change / net[p]);
+    }
+    if (static_cast<int>(per_event.size()) >= options.min_pixels) {
+      change = Median(per_event);
+      estimate.estimated_from_frames = true;
+      pixels_used = static_cast<int>(per_event.size());
+    }
+  }
+
+  if (!estimate.estimated_from_frames) {
+    change = model.model == EventModel::kLog ? options.assumed_contrast_threshold
+                                             : options.assumed_linear_change;
+  }
+  estimate.change_per_event = change;
+  estimate.alpha = options.alpha_times_change / change;
+
+  char line[256];
+  if (estimate.estimated_from_frames) {
+    std::snprintf(line, sizeof(line),
+                  "change per event %.4f (measured between the frames at %d pixels), "
+                  "alpha %.2f",
+                  estimate.change_per_event, pixels_used, estimate.alpha);
+  } else {
+    std::snprintf(line, sizeof(line),
+                  "change per event %.4f (assumed: no two sharp frames to measure it), "
+                  "alpha %.2f",
+                  estimate.change_per_event, estimate.alpha);
+  }
+  estimate.description = line;
+  return estimate;
+}
+
+}  // namespace evfs

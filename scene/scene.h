@@ -1,0 +1,127 @@
+// A reconstruction problem as data: what was observed (frames with their exposure spans, event
+// frames with their latent spans) on one latent timeline (DESIGN.md §1–2). Interpolation,
+// prediction and deblurring are presets of this one structure; the solver never branches on
+// the case.
+#ifndef EVFS_SCENE_SCENE_H_
+#define EVFS_SCENE_SCENE_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/event_frames.h"
+#include "core/event_stream.h"
+#include "core/video.h"
+#include "events/binning.h"
+
+namespace evfs {
+
+/// An intensity frame as recorded: sharp when exposure_begin_ns == exposure_end_ns, otherwise
+/// the time average of the scene over its exposure (a motion-blurred frame).
+struct TimedFrame {
+  Image image;
+  int64_t exposure_begin_ns = 0;
+  int64_t exposure_end_ns = 0;
+  std::string label;  // where it came from, for messages ("images/frame_00000070.png")
+};
+
+/// One frame observation on the latent timeline: F_j = mean(H_a … H_b).
+struct FrameObservation {
+  Image image;
+  int latent_first = 0;
+  int latent_last = 0;
+  std::string label;
+};
+
+/// How events are binned into event frames (paper §3.3). Every method honours
+/// max_latent_voxels: the binning is decided from counts (CountCollisionFrames) before any frame
+/// is allocated, and one that would exceed it is either avoided (kAuto) or refused (kCollision,
+/// kStacked: InvalidArgumentError naming the option).
+struct BinningOptions {
+  enum class Method {
+    kAuto,       // collision binning unless it gives more steps than the limits allow
+    kCollision,  // the paper's Binning 1: one step per collision frame, values in {-1, 0, 1}
+    kStacked,    // the paper's Binning 2: StackedBinningOptions
+  };
+  Method method = Method::kAuto;
+  /// kAuto: the most latent steps; above it, stacked equal-time binning with this many frames
+  /// is used instead (memory and time grow linearly with latent frames).
+  int max_latent_frames = 48;
+  /// Every method: the most latent voxels (pixels × latent frames). kAuto gives larger sensors
+  /// fewer steps (as many as fit, at least 1); kCollision and kStacked beyond it are refused.
+  /// 12 M keeps all 48 steps up to 500×500: with quiet steps merged (LatentLayout) the
+  /// solver's memory follows the unknowns and residuals (peak 1.7 GB on the busy 500×500
+  /// adobe240_GOPR9637b clip at 48 latent frames); on the 500×500 adobe240_IMG_0036 clip going from 8 to 48 latent frames turned interpolation from
+  /// −2.6 to +0.6 dB over the blend and deblurring from +1.4 to +2.4 dB over the blurred frame.
+  int64_t max_latent_voxels = 12000000;
+  /// Every method: pixels with more than this many times the events of the scene's busy pixels
+  /// are hot (MeasurePixelActivity) and their events are left out before binning, so that a
+  /// stuck pixel neither multiplies the collision frames nor bends its own pixel; 0 keeps every
+  /// event. 10 is more than twice the largest ratio in the shared DAVIS recordings (4.4).
+  double hot_pixel_factor = 10.0;
+  StackedBinningOptions stacked;  // used by kStacked
+
+  bool IsValid(std::string* error) const;
+};
+
+/// What binning a window gets, decided from counts alone (no frame is allocated).
+struct BinningPlan {
+  BinningOptions::Method method = BinningOptions::Method::kCollision;  // kCollision or kStacked
+  StackedBinningOptions stacked;  // kStacked: the frames and steps used
+  int num_event_frames = 0;
+  int num_latent_frames = 2;
+  int64_t pixels = 0;             // of the sensor
+  int64_t collision_frames = 0;   // what collision binning gives, hot pixels left out
+  PixelActivity activity;         // hot pixels and counts, before leaving any out
+
+  int64_t latent_voxels() const { return pixels * num_latent_frames; }
+};
+
+/// Decides the binning of the events in [window_begin_ns, window_end_ns) from counts. Throws
+/// InvalidArgumentError, naming the option to change, when the binning asked for would exceed
+/// binning.max_latent_voxels (explicit collision or stacked binning over it, or a sensor on
+/// which not even one latent step fits), for invalid options, or as the binning functions do.
+BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns,
+                        int64_t window_end_ns, const BinningOptions& binning);
+
+struct Scene {
+  int height = 0;
+  int width = 0;
+  std::vector<FrameObservation> frames;
+  /// Event frames; their spans and latent_timestamps_ns() define the latent timeline.
+  EventFrames events;
+  int64_t num_events = 0;  // events binned into `events`
+  /// Pixels whose events were left out as hot (row-major indices), and how many events they had.
+  std::vector<int32_t> hot_pixels;
+  int64_t hot_pixel_events = 0;
+
+  int num_latent_frames() const { return static_cast<int>(events.latent_timestamps_ns().size()); }
+  const std::vector<int64_t>& latent_timestamps_ns() const {
+    return events.latent_timestamps_ns();
+  }
+};
+
+/// Builds the general scene: bins `events` over [window_begin_ns, window_end_ns) as PlanBinning
+/// decides, then ties each frame to the latent frames of its exposure (a sharp frame to the
+/// nearest latent frame). Throws InvalidArgumentError when a frame lies outside the window,
+/// sizes disagree or PlanBinning refuses.
+Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events,
+                int64_t window_begin_ns, int64_t window_end_ns, const BinningOptions& binning);
+
+/// Interpolation (paper §3.2): sharp frames at both ends of the window.
+Scene MakeInterpolationScene(const TimedFrame& first, const TimedFrame& last,
+                             const EventStream& events, const BinningOptions& binning);
+/// Prediction: a sharp frame at the start and events up to window_end_ns.
+Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns,
+                          const EventStream& events, const BinningOptions& binning);
+/// Motion deblur: one blurred frame whose exposure is the window.
+Scene MakeDeblurScene(const TimedFrame& blurred, const EventStream& events,
+                      const BinningOptions& binning);
+
+/// The initialisation of DESIGN.md §1: the frame observations blended linearly along the latent
+/// timeline (a copy when there is only one, held constant beyond the first and last).
+Video InitializeLatentVideo(const Scene& scene);
+
+}  // namespace evfs
+
+#endif  // EVFS_SCENE_SCENE_H_

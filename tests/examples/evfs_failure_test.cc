@@ -1,0 +1,207 @@
+// How `evfs` fails, end to end: whose fault each failure is (exit status 2 for the user's, 3 for
+// evfs' own bugs, 4 for a solver that failed), that each is one line saying what is wrong, and
+// that a long command reports progress wherever stderr goes (issue 14, "Failure semantics").
+// Each test works in a scratch folder of its own.
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/examples/cli_test_util.h"
+#include "tests/io/io_test_util.h"
+#include "tests/test_data.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+
+using test::CommandResult;
+using test::ExpectNoStagingLeft;
+using test::ExpectUserError;
+using test::RunEvfs;
+using test::WriteSyntheticFolder;
+
+// Exit statuses (core/error.h, ExitStatus).
+constexpr int kSolverFailureStatus = 4;
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::stringstream stream(text);
+  for (std::string line; std::getline(stream, line);) lines.push_back(line);
+  return lines;
+}
+
+// gflags used to print its own text and exit with status 1.
+TEST(EvfsFailure, FlagsThatDoNotParseAreOneLineUserErrors) {
+  const fs::path scratch = testing::ScratchDir("failure_flags");
+  const fs::path out = scratch / "out";
+  const std::string data = WriteSyntheticFolder(scratch.string());
+  const std::string reconstruct =
+      "reconstruct --data=" + data + " --mode=predict --first=0 --out=" + out.string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"info --bogus=1", "evfs: unknown flag --bogus"},
+      {reconstruct + " --fps=abc", "evfs: --fps=abc: expected a number"},
+      {"info --first=x", "evfs: --first=x: expected a whole number"},
+      {"info --first 99999999999", "evfs: --first=99999999999: expected a whole number"},
+      {reconstruct + " --bounds=maybe", "evfs: --bounds=maybe: expected true or false"},
+      {"info --data", "evfs: --data needs a value"},
+      {"info --nodata", "evfs: unknown flag --nodata"},
+      {"--flagfile=" + (scratch / "none").string() + " info", "cannot read"},
+  };
+  for (const auto& [arguments, expected] : cases) {
+    SCOPED_TRACE(arguments);
+    const CommandResult result = RunEvfs(arguments);
+    ExpectUserError(result, expected, out);
+    EXPECT_EQ(result.output, result.errors) << "printed on stdout too";
+  }
+}
+
+// gflags ended every help flag with status 1.
+TEST(EvfsFailure, HelpAskedForIsASuccess) {
+  for (const char* flag : {"--help", "-help", "--helpfull", "--helpshort", "--helpon=evfs_main"}) {
+    SCOPED_TRACE(flag);
+    const CommandResult result = RunEvfs(flag);
+    EXPECT_EQ(result.exit_code, 0);
+    EXPECT_EQ(result.errors, "");
+    EXPECT_NE(result.output.find("usage:"), std::string::npos) << result.output;
+    EXPECT_NE(result.output.find("-progress_interval_s"), std::string::npos);
+  }
+  const CommandResult match = RunEvfs("--helpmatch=evfs_main");
+  EXPECT_EQ(match.exit_code, 0);
+  EXPECT_NE(match.output.find("-progress_interval_s"), std::string::npos) << match.output;
+  const CommandResult version = RunEvfs("--version");
+  EXPECT_EQ(version.exit_code, 0);
+}
+
+// α = 1e308 with b = 1e-300 in g(x) = log(x + b): at any pixel with events darker than about
+// 0.5, α · g'(x) overflows, so the event residuals' Jacobian is not finite at the start and
+// Ceres ends with FAILURE. The input was accepted, so it is not the user's error (status 2) but the
+// solver's: status 4, one line (Ceres' own dump is shown with --minloglevel=0 only), and no
+// output.
+TEST(EvfsFailure, CeresFailureIsASolverFailureNotAUserError) {
+  const fs::path scratch = testing::ScratchDir("failure_solver");
+  const fs::path out = scratch / "out";
+  const std::string data = WriteSyntheticFolder(scratch.string());
+  const CommandResult result = RunEvfs("reconstruct --data=" + data +
+                                       " --mode=interpolate --first=0 --last=1 --alpha=1e308 "
+                                       "--log_offset=1e-300 --out=" +
+                                       out.string());
+  EXPECT_EQ(result.exit_code, kSolverFailureStatus) << result.output;
+  EXPECT_EQ(Lines(result.errors).size(), 1u) << result.errors;
+  EXPECT_EQ(result.errors.rfind("evfs reconstruct: the solver failed: ", 0), 0u) << result.errors;
+  EXPECT_FALSE(fs::exists(out));
+  ExpectNoStagingLeft(out);
+}
+
+// events.txt or images.txt that exists but is no regular file used to read as "this folder
+// holds frames only" (or, for images.txt, as no frames at all).
+TEST(EvfsFailure, DataFileThatIsNoRegularFileIsNamedAsSuch) {
+  const fs::path scratch = testing::ScratchDir("failure_not_a_file");
+  const fs::path out = scratch / "out";
+  const fs::path data = WriteSyntheticFolder(scratch.string());
+  const std::string reconstruct =
+      "reconstruct --data=" + data.string() + " --mode=predict --first=0 --out=" + out.string();
+
+  const fs::path events_txt = data / "events.txt";
+  const fs::path events_aside = scratch / "events.txt";
+  fs::rename(events_txt, events_aside);
+  fs::create_directory(events_txt);
+  const std::string folder_message =
+      events_txt.string() + ": a folder, not a file of events ('t x y p' lines)";
+  ExpectUserError(RunEvfs("info --data=" + data.string()), folder_message, out);
+  ExpectUserError(RunEvfs(reconstruct), folder_message, out);
+
+  fs::remove(events_txt);
+  ASSERT_EQ(mkfifo(events_txt.c_str(), 0600), 0);
+  const std::string fifo_message =
+      events_txt.string() + ": a FIFO, socket or device, not a file of events";
+  ExpectUserError(RunEvfs("info --data=" + data.string()), fifo_message, out);
+  ExpectUserError(RunEvfs(reconstruct), fifo_message, out);
+  fs::remove(events_txt);
+  fs::rename(events_aside, events_txt);
+
+  const fs::path images_txt = data / "images.txt";
+  fs::remove(images_txt);
+  fs::create_directory(images_txt);
+  ExpectUserError(RunEvfs("info --data=" + data.string()),
+                  images_txt.string() + ": a folder, not a file of frames ('t path' lines)", out);
+}
+
+// A folder without images.txt is events alone: `info` describes it (status 0) and says why it
+// lists no frame; reading a frame says the same instead of "has 0 frames (0..-1)".
+TEST(EvfsFailure, MissingFrameListIsNamed) {
+  const fs::path scratch = testing::ScratchDir("failure_no_frames");
+  const fs::path out = scratch / "out";
+  const fs::path data = WriteSyntheticFolder(scratch.string());
+  const fs::path images_txt = data / "images.txt";
+  fs::remove(images_txt);
+  const std::string reason = "(there is no " + images_txt.string() + ")";
+
+  const CommandResult info = RunEvfs("info --data=" + data.string());
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("frames      0 " + reason), std::string::npos) << info.output;
+  ExpectUserError(RunEvfs("info --data=" + data.string() + " --first=0"),
+                  data.string() + " has 0 frames " + reason, out);
+  ExpectUserError(RunEvfs("reconstruct --data=" + data.string() +
+                          " --mode=predict --first=0 --out=" + out.string()),
+                  data.string() + " has 0 frames " + reason, out);
+
+  // The same recording as HDF5: it has no /images group.
+  const fs::path h5 = scratch / "events_only.h5";
+  ASSERT_EQ(RunEvfs("convert --data=" + data.string() + " --out=" + h5.string()).exit_code, 0);
+  ExpectUserError(RunEvfs("reconstruct --data=" + h5.string() +
+                          " --mode=predict --first=0 --out=" + out.string()),
+                  h5.string() + " has 0 frames (", out);
+}
+
+// Progress lines (app/progress.h) look like
+//   evfs reconstruct: 0.0 s elapsed             (before the job names its first stage)
+//   evfs reconstruct: build and solve, 0.1 s elapsed
+//   evfs reconstruct: solve, iteration 3 (cost 1.234567e-01), 0.2 s elapsed
+const std::regex kProgressLine(
+    "evfs reconstruct: ((read|bin|build|build and solve|solve|write)"
+    "(, iteration [0-9]+ \\(cost [-+.e0-9]+\\))?, )?[0-9]+\\.[0-9] s elapsed");
+
+// stderr is a file here, not a terminal: a command running longer than the interval still
+// says what it does, on a line of its own every interval.
+TEST(EvfsFailure, ProgressIsPrintedOffATerminal) {
+  const fs::path scratch = testing::ScratchDir("failure_progress");
+  const std::string data = WriteSyntheticFolder(scratch.string());
+  // An interval far below the job's length (a fork, a read, a build and a solve: well over
+  // 10 ms), so that several lines come.
+  const CommandResult result =
+      RunEvfs("reconstruct --data=" + data + " --mode=interpolate --first=0 --last=2 --out=" +
+              (scratch / "out").string() + " --progress_interval_s=0.002");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> lines = Lines(result.errors);
+  ASSERT_GE(lines.size(), 1u) << result.errors;
+  for (const std::string& line : lines) {
+    EXPECT_TRUE(std::regex_match(line, kProgressLine)) << line;
+  }
+}
+
+TEST(EvfsFailure, QuickCommandsPrintNoProgress) {
+  const fs::path scratch = testing::ScratchDir("failure_quick");
+  const std::string data = WriteSyntheticFolder(scratch.string());
+  const CommandResult result =
+      RunEvfs("reconstruct --data=" + data +
+              " --mode=predict --first=0 --out=" + (scratch / "out").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.errors, "");
+  // --progress keeps its line per iteration.
+  const CommandResult every =
+      RunEvfs("reconstruct --data=" + data +
+              " --mode=predict --first=0 --progress --out=" + (scratch / "out2").string());
+  ASSERT_EQ(every.exit_code, 0) << every.output;
+  EXPECT_EQ(every.errors.rfind("iter    0  cost ", 0), 0u) << every.errors;
+}
+
+}  // namespace
+}  // namespace evfs
