@@ -24,7 +24,7 @@ test: build
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.
 test-sanitize: deps
 	@$(MAKE) --no-print-directory test BUILD_DIR=build-asan \
-	  CMAKE_FLAGS="-DEVFS_SANITIZE=ON -DEVFS_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo"
+	  CMAKE_FLAGS="-DEVFS_SANITIZE=ON -DEVFS_WERROR=ON -DEVFS_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo"
 
 # libFuzzer targets (clang, ASan+UBSan) in build-fuzz/, each run for FUZZ_SECONDS from seeds
 # cut from the shared data; stops at the first finding, whose input is left in

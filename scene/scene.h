@@ -49,10 +49,8 @@ struct BinningOptions {
   int max_latent_frames = 48;
   /// Every method: the most latent voxels (pixels × latent frames). kAuto gives larger sensors
   /// fewer steps (as many as fit, at least 1); kCollision and kStacked beyond it are refused.
-  /// 12 M keeps all 48 steps up to 500×500: with quiet steps merged (LatentLayout) the
-  /// solver's memory follows the unknowns and residuals (peak 1.7 GB on the busy 500×500
-  /// adobe240_GOPR9637b clip at 48 latent frames); on the 500×500 adobe240_IMG_0036 clip going from 8 to 48 latent frames turned interpolation from
-  /// −2.6 to +0.6 dB over the blend and deblurring from +1.4 to +2.4 dB over the blurred frame.
+  /// 12 M keeps all 48 steps up to 500×500, where fewer steps cost accuracy, within the memory
+  /// of a laptop (BENCHMARKS.md, "Where the defaults come from").
   int64_t max_latent_voxels = 12000000;
   /// Every method: pixels with more than this many times the events of the scene's busy pixels
   /// are hot (MeasurePixelActivity) and their events are left out before binning, so that a

@@ -6,6 +6,8 @@ set -euo pipefail
 
 packages=(
   cmake make g++ pkg-config
+  # The clang_format test (tests/CMakeLists.txt).
+  clang-format
   libceres-dev libeigen3-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev
   # AEDAT 4 (io/aedat4.cc); the python3 modules decode the real sample independently in a test.

@@ -21,30 +21,22 @@ namespace evfs {
 /// path length of a pixel's intensity do not grow with K), the spatial TV is a mean over frames
 /// (summed, it would blur more the more latent frames there are).
 struct ObjectiveOptions {
-  /// Weight of the frame term (paper Eq. 3), per frame observation. 4 by measurement
-  /// (reconstruction_benchmark --frame_weight=W; slider prediction / shapes interpolation / cups
-  /// deblur mean-vs-input / nfs interpolation gain): W 1: 25.73 / 32.61 / 32.55 / -3.75 dB;
-  /// W 2: 25.50 / 33.57 / 34.59 / -1.76; W 4: 25.22 / 34.47 / 36.91 / -0.81; W 8: 24.99 / 34.66
-  /// / 39.57 / -0.52. Smaller weights let the events pull the frames away from what was
-  /// observed (the notes found the same under sum norms).
+  /// Weight of the frame term (paper Eq. 3), per frame observation. Smaller weights let the
+  /// events pull the frames away from what was observed (sweep: BENCHMARKS.md, "Where the
+  /// defaults come from").
   double frame_weight = 4.0;
-  /// λ_e: weight of the event term (paper Eq. 2), per event frame, and λ_t, below: 0.3 and
-  /// 0.85 by measurement with the log model of b = 0.5 (README, "The model and its defaults",
-  /// has the sweep: reconstruction_benchmark --event_weight=E --temporal_tv_weight=T). Weaker
-  /// event and temporal terms let the frames and the spatial TV hold what the events do not
-  /// say; a stronger event term overshoots in deblurring (E 0.5: +0.67 dB on GOPR9637b against
-  /// +3.29 dB at 0.3), a weaker one loses slider_depth prediction (E 0.25, T 1.0: 24.69 dB).
+  /// λ_e: weight of the event term (paper Eq. 2), per event frame. With λ_t, below, weak
+  /// enough that the frames and the spatial TV hold what the events do not say, strong enough
+  /// for prediction (sweep: README, "The model and its defaults", and BENCHMARKS.md).
   double event_weight = 0.3;
   /// λ_xy: weight of spatial total variation (paper Eq. 4), mean over latent frames.
   double spatial_tv_weight = 2.0;
   /// λ_t: weight of temporal total variation (paper Eq. 5), per latent step.
   double temporal_tv_weight = 0.85;
-  /// g and α of the event model: by default the log model g(x) = log(x + 0.5) with α derived
-  /// from the data (α <= 0, EstimateEventModel). b = 0.5 by measurement (README sweep): the
-  /// log model fits the log-intensity events of the simulated clips (interpolation +0.2 to
-  /// +1.8 dB over the linear model) and b = 0.5 keeps slider_depth prediction, where the DAVIS
-  /// frames' response makes the linear model fit best, above 25 dB (b 0.1: 23.98 dB, 0.3:
-  /// 24.93, 1.0: 24.90).
+  /// g and α of the event model: by default the log model g(x) = log(x + 0.5), which matches
+  /// the log-intensity events of a sensor, with α derived from the data (α <= 0,
+  /// EstimateEventModel); b = 0.5 keeps DAVIS frames, whose response is nearly linear, well
+  /// fitted (sweep: README and BENCHMARKS.md).
   EventModelParams event_model = DefaultEventModel();
   /// Form of the spatial TV.
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
