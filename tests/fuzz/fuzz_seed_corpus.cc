@@ -11,6 +11,8 @@
 //                    ConvertRecording, the code behind `evfs convert`
 //
 //   fuzz_seed_corpus DATA_DIR OUT
+#include <flatbuffers/flatbuffers.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -19,8 +21,6 @@
 #include <iterator>
 #include <string>
 #include <vector>
-
-#include <flatbuffers/flatbuffers.h>
 
 #include "core/error.h"
 #include "io/aedat4.h"
