@@ -1,7 +1,8 @@
 #include "app/crash_guard.h"
 
-#include <sys/prctl.h>
+#include <glog/logging.h>
 #include <sys/mman.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,8 +14,6 @@
 #include <iterator>
 #include <utility>
 #include <vector>
-
-#include <glog/logging.h>
 
 #include "core/error.h"
 #include "io/hdf5_io.h"

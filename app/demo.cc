@@ -5,12 +5,12 @@
 #include <fstream>
 #include <vector>
 
+#include "app/reconstruct_job.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
-#include "app/reconstruct_job.h"
 #include "io/data_source.h"
 #include "io/text_folder.h"
 
@@ -26,8 +26,8 @@ constexpr int kWidth = 120;
 constexpr int kHeight = 96;
 constexpr double kRenderFps = 1000.0;
 constexpr double kDurationS = 0.04;
-constexpr int kFrameEveryRendered = 10;   // a recorded frame every 10 ms
-constexpr double kBlurBeginS = 0.010;     // exposure of the blurred frame
+constexpr int kFrameEveryRendered = 10;  // a recorded frame every 10 ms
+constexpr double kBlurBeginS = 0.010;    // exposure of the blurred frame
 constexpr double kBlurEndS = 0.030;
 
 struct DemoCase {
@@ -69,8 +69,8 @@ int RunDemo(const std::string& folder, const std::string& shown_as) {
   const SceneSynthesizer synthesizer(scene_options);
   const Video rendered = synthesizer.RenderAtRate(kRenderFps);
   const EventStream events = SimulateEvents(rendered, SimulatorOptions());
-  std::printf("demo scene: %dx%d, %d frames rendered at %.0f fps, %zu simulated events\n",
-              kWidth, kHeight, rendered.num_frames(), kRenderFps, events.size());
+  std::printf("demo scene: %dx%d, %d frames rendered at %.0f fps, %zu simulated events\n", kWidth,
+              kHeight, rendered.num_frames(), kRenderFps, events.size());
 
   std::vector<Image> sharp_images;
   const std::vector<FrameInfo> sharp_frames = SharpFrames(rendered, &sharp_images);

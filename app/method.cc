@@ -4,8 +4,8 @@
 
 #include "baselines/baseline.h"
 #include "core/error.h"
-#include "core/time.h"
 #include "core/metrics.h"
+#include "core/time.h"
 #include "scene/activity_mask.h"
 #include "scene/scene.h"
 
@@ -54,8 +54,7 @@ IterationCallback Observer(const IterationCallback& progress, bool record_checkp
 
 void RunCeresLm(const Scene& scene, const MethodOptions& options, const Video& initial,
                 const IterationCallback& observer, MethodResult* result) {
-  Reconstruction reconstruction =
-      Reconstruct(scene, options.reconstruction, &initial, observer);
+  Reconstruction reconstruction = Reconstruct(scene, options.reconstruction, &initial, observer);
   const ReconstructionSummary& summary = reconstruction.summary;
   result->video = std::move(reconstruction.video);
   result->solved = summary.solved;
@@ -71,8 +70,8 @@ void RunCeresLm(const Scene& scene, const MethodOptions& options, const Video& i
 void RunFirstOrder(const Scene& scene, const MethodOptions& options, const Video& initial,
                    const IterationCallback& observer, MethodResult* result) {
   ReconstructionSummary& summary = result->reconstruction;
-  const ObjectiveOptions objective = ResolveObjective(scene, options.reconstruction,
-                                                      &summary.model, &summary.alpha_derived);
+  const ObjectiveOptions objective =
+      ResolveObjective(scene, options.reconstruction, &summary.model, &summary.alpha_derived);
   result->video = initial;
   if (scene.num_events == 0) {
     result->message = "no events in the window: the initialisation is the answer";
@@ -137,8 +136,8 @@ std::vector<Method> AllMethods() {
 }
 
 bool IsIterative(Method method) {
-  return method == Method::kCeresLm || method == Method::kCeresLbfgs ||
-         method == Method::kAdam || method == Method::kAdamSmooth;
+  return method == Method::kCeresLm || method == Method::kCeresLbfgs || method == Method::kAdam ||
+         method == Method::kAdamSmooth;
 }
 
 bool MethodSupports(Method method, const Scene& scene, std::string* why_not) {

@@ -12,15 +12,15 @@
 #include <string>
 #include <vector>
 
+#include "app/initialization.h"
 #include "baselines/baseline.h"
 #include "baselines/baseline_options.h"
 #include "core/video.h"
-#include "app/initialization.h"
+#include "scene/scene.h"
 #include "solver/first_order_solvers.h"
 #include "solver/iteration_callback.h"
 #include "solver/reconstruction_options.h"
 #include "solver/reconstructor.h"
-#include "scene/scene.h"
 
 namespace evfs {
 
@@ -99,8 +99,7 @@ struct MethodResult {
 /// cost, PSNR and SSIM are recorded. Throws InvalidArgumentError for invalid options or a scene
 /// the method does not support.
 MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
-                       const IterationCallback& progress = nullptr,
-                       bool record_checkpoints = false,
+                       const IterationCallback& progress = nullptr, bool record_checkpoints = false,
                        const CheckpointTruth* truth = nullptr);
 
 }  // namespace evfs

@@ -7,10 +7,10 @@
 #include <fstream>
 #include <memory>
 
+#include "app/json_writer.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
-#include "app/json_writer.h"
 #include "io/data_source.h"
 #include "io/image_io.h"
 
@@ -34,8 +34,8 @@ void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   if (index < 0 || index >= count) {
     throw InvalidArgumentError(std::string(what) + " frame " + std::to_string(index) +
                                " is out of range: " + source.path() + " has " +
-                               std::to_string(count) + " frames (0.." +
-                               std::to_string(count - 1) + ")");
+                               std::to_string(count) + " frames (0.." + std::to_string(count - 1) +
+                               ")");
   }
 }
 
@@ -72,12 +72,10 @@ Video Resample(const Video& latent, double fps) {
   const double step_ns = static_cast<double>(kNanosecondsPerSecond) / fps;  // inf for tiny fps
   // The frame count is bounded in double before any i · step_ns is rounded to int64: a tiny
   // --fps made that product wrap and the loop run forever, allocating.
-  const double last_index =
-      std::floor((static_cast<double>(end_ns - begin_ns) + 0.5) / step_ns);
+  const double last_index = std::floor((static_cast<double>(end_ns - begin_ns) + 0.5) / step_ns);
   Video output;
   for (int64_t i = 0; i <= last_index; ++i) {
-    const int64_t t_ns =
-        begin_ns + (i == 0 ? 0 : static_cast<int64_t>(std::llround(i * step_ns)));
+    const int64_t t_ns = begin_ns + (i == 0 ? 0 : static_cast<int64_t>(std::llround(i * step_ns)));
     if (t_ns > end_ns) break;
     output.AppendFrame(latent.InterpolateAt(t_ns), t_ns);
   }
@@ -136,9 +134,8 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   if (request.mode != Mode::kDeblur) {
     CheckFrameIndex(*source, last, "the last");
     if (last <= request.first) {
-      throw InvalidArgumentError("--last (" + std::to_string(last) +
-                                 ") must come after --first (" + std::to_string(request.first) +
-                                 ")");
+      throw InvalidArgumentError("--last (" + std::to_string(last) + ") must come after --first (" +
+                                 std::to_string(request.first) + ")");
     }
   }
   if (request.truth >= 0) CheckFrameIndex(*source, request.truth, "the truth");

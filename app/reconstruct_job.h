@@ -8,8 +8,8 @@
 #include <functional>
 #include <string>
 
-#include "core/video.h"
 #include "app/method.h"
+#include "core/video.h"
 #include "scene/scene.h"
 
 namespace evfs {
@@ -24,10 +24,10 @@ struct ReconstructRequest {
   std::string data_path;   // data folder or HDF5 file
   std::string data_label;  // how summary.json names the data ("": data_path)
   Mode mode = Mode::kPredict;
-  int first = 0;    // images.txt line (0-based) of the first / blurred frame
-  int last = -1;    // interpolate: the last frame; predict: the frame whose time ends the window
-                    // (-1: first + 1)
-  int truth = -1;   // frame to score against (-1: none)
+  int first = 0;   // images.txt line (0-based) of the first / blurred frame
+  int last = -1;   // interpolate: the last frame; predict: the frame whose time ends the window
+                   // (-1: first + 1)
+  int truth = -1;  // frame to score against (-1: none)
   double exposure_s = 0.0;  // deblur: exposure around the frame's timestamp when the data has none
   double fps = 0.0;         // > 0: resample the latent video to this uniform rate
   BinningOptions binning;
@@ -43,9 +43,9 @@ struct ReconstructRequest {
 };
 
 struct TruthScore {
-  int index = -1;            // images.txt line of the truth frame
-  int64_t timestamp_ns = 0;  // its timestamp
-  int latent_index = -1;     // latent frame nearest to it
+  int index = -1;                                   // images.txt line of the truth frame
+  int64_t timestamp_ns = 0;                         // its timestamp
+  int latent_index = -1;                            // latent frame nearest to it
   double psnr = 0.0, ssim = 0.0;                    // reconstruction against truth
   double baseline_psnr = 0.0, baseline_ssim = 0.0;  // initialisation (blend or copy) against truth
 };
@@ -59,11 +59,11 @@ struct ReconstructResult {
   int width = 0, height = 0;
   int64_t events = 0;  // events in the window (binned; hot pixels' left out)
   int event_frames = 0;
-  int hot_pixels = 0;             // pixels whose events were left out as hot (BinningOptions)
-  int64_t hot_pixel_events = 0;   // their events
-  MethodResult run;               // latent video and what the method did
-  Video output;                   // the latent video, or its resampling at request.fps
-  Video baseline;                 // blend or copy on the latent timeline (the score's reference)
+  int hot_pixels = 0;            // pixels whose events were left out as hot (BinningOptions)
+  int64_t hot_pixel_events = 0;  // their events
+  MethodResult run;              // latent video and what the method did
+  Video output;                  // the latent video, or its resampling at request.fps
+  Video baseline;                // blend or copy on the latent timeline (the score's reference)
   bool has_truth = false;
   TruthScore truth;
   StageTimes time;

@@ -6,6 +6,9 @@
 //
 //   build/benchmarks/active_fraction_benchmark [--fractions=0,0.05,0.1,0.25,0.5,1] [--repeats=3]
 
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,13 +16,10 @@
 #include <string>
 #include <vector>
 
-#include <gflags/gflags.h>
-#include <glog/logging.h>
-
+#include "app/allocator_tuning.h"
 #include "core/metrics.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
-#include "app/allocator_tuning.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(fractions, "0,0.05,0.1,0.25,0.5,0.75,1",
@@ -73,15 +73,16 @@ TimedFrame Sharp(const Video& video, int t) {
 }
 
 int Run() {
-  std::printf("| active fraction | events | active pixels | unknowns | latent frames | build s "
-              "| solve s | µs per unknown | PSNR gain over blend |\n");
+  std::printf(
+      "| active fraction | events | active pixels | unknowns | latent frames | build s "
+      "| solve s | µs per unknown | PSNR gain over blend |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const double fraction : ParseFractions(FLAGS_fractions)) {
     const Video video = BandVideo(fraction);
     const EventStream events = SimulateEvents(video, SimulatorOptions());
     const int last = video.num_frames() - 1, middle = last / 2;
-    const Scene scene = MakeInterpolationScene(Sharp(video, 0), Sharp(video, last), events,
-                                               BinningOptions());
+    const Scene scene =
+        MakeInterpolationScene(Sharp(video, 0), Sharp(video, last), events, BinningOptions());
     std::vector<double> build_s, solve_s;
     Reconstruction result;
     for (int r = 0; r < FLAGS_repeats; ++r) {

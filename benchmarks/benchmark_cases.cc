@@ -31,8 +31,7 @@ std::vector<std::string> SplitCommaList(const std::string& list) {
   return items;
 }
 
-SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& name,
-                                int crop_px) {
+SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& name, int crop_px) {
   const fs::path folder = fs::path(data_dir) / name;
   const std::string list_path = (folder / "images.txt").string();
   const std::vector<FrameInfo> list = ReadFrameList(list_path);
@@ -47,8 +46,8 @@ SimulatedClip LoadSimulatedClip(const std::string& data_dir, const std::string& 
     if (crop_px > 0) {
       const int height = std::min<int>(crop_px, frame.rows());
       const int width = std::min<int>(crop_px, frame.cols());
-      frame = Image(frame.block((frame.rows() - height) / 2, (frame.cols() - width) / 2, height,
-                                width));
+      frame = Image(
+          frame.block((frame.rows() - height) / 2, (frame.cols() - width) / 2, height, width));
     }
     clip.frames.AppendFrame(frame, list[i].t_ns);
   }

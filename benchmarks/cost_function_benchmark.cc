@@ -21,11 +21,11 @@
 #include <vector>
 
 #include "cost_functions/difference_residual.h"
-#include "scene/event_model.h"
 #include "cost_functions/event_residual.h"
 #include "cost_functions/frame_residual.h"
 #include "cost_functions/spatial_tv_residual.h"
 #include "scene/activity_mask.h"
+#include "scene/event_model.h"
 #include "solver/first_order_solvers.h"
 #include "solver/fused_objective.h"
 #include "solver/problem_builder.h"

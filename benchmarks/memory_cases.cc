@@ -16,6 +16,9 @@
 // to measure what a hot pixel does to the accuracy on real data.
 //
 // benchmarks/memory_benchmark.sh runs evfs on them under /usr/bin/time -v.
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -25,23 +28,24 @@
 #include <tuple>
 #include <vector>
 
-#include <gflags/gflags.h>
-#include <glog/logging.h>
-
 #include "core/error.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
 #include "io/data_source.h"
 #include "io/text_folder.h"
 
-DEFINE_string(out, "", "Folder to write hot_pixel/ and busy_640x480/ into (created; must not "
+DEFINE_string(out, "",
+              "Folder to write hot_pixel/ and busy_640x480/ into (created; must not "
               "hold them already).");
-DEFINE_int32(hot_pixel_events, 10000, "Events of the hot pixel (between the two frames, or "
+DEFINE_int32(hot_pixel_events, 10000,
+             "Events of the hot pixel (between the two frames, or "
              "over the events of --add_hot_pixel_to).");
-DEFINE_string(add_hot_pixel_to, "", "A recording to copy into OUT/NAME_hot with a hot pixel "
+DEFINE_string(add_hot_pixel_to, "",
+              "A recording to copy into OUT/NAME_hot with a hot pixel "
               "added, instead of writing the two synthetic cases.");
 DEFINE_int64(busy_events, 2000000, "Events of the 640x480 case (within 2 %: the pan is scaled).");
-DEFINE_double(busy_noise_fraction, 0.5, "Fraction of the 640x480 case's events that are "
+DEFINE_double(busy_noise_fraction, 0.5,
+              "Fraction of the 640x480 case's events that are "
               "background noise (which collision binning turns into thousands of frames).");
 
 namespace evfs {
@@ -86,9 +90,8 @@ EventStream WithHotPixel(const EventStream& events, int x, int y, int count, int
     all.emplace_back(t_begin_ns + 1 + (t_end_ns - t_begin_ns - 2) * i / count,
                      static_cast<uint16_t>(x), static_cast<uint16_t>(y), i % 2 ? 1 : -1);
   }
-  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
-    return std::get<0>(a) < std::get<0>(b);
-  });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
   EventStream merged(events.width(), events.height());
   merged.reserve(all.size());
   for (const auto& [t_ns, ex, ey, polarity] : all) merged.push_back(t_ns, ex, ey, polarity);
@@ -176,8 +179,7 @@ int Main() {
   }
   for (const char* name : {"hot_pixel", "busy_640x480"}) {
     if (fs::exists(out / name)) {
-      std::fprintf(stderr, "memory_cases: %s exists; pass a fresh --out\n",
-                   (out / name).c_str());
+      std::fprintf(stderr, "memory_cases: %s exists; pass a fresh --out\n", (out / name).c_str());
       return 2;
     }
   }
@@ -191,8 +193,9 @@ int Main() {
 }  // namespace evfs
 
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("writes the hot-pixel and 2 M-event recordings of BENCHMARKS.md's "
-                          "memory section");
+  gflags::SetUsageMessage(
+      "writes the hot-pixel and 2 M-event recordings of BENCHMARKS.md's "
+      "memory section");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);
   try {

@@ -6,6 +6,9 @@
 //
 //   reconstruction_benchmark --data=../shared/data [--cases=slider,shapes,cups,clips]
 //                            [--clips=nfs_basketball_7,adobe240_GOPR9637b,...] [--csv=FILE]
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -15,16 +18,13 @@
 #include <string>
 #include <vector>
 
-#include <gflags/gflags.h>
-#include <glog/logging.h>
-
+#include "app/allocator_tuning.h"
+#include "app/reconstruct_job.h"
 #include "benchmarks/benchmark_cases.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
 #include "events/simulator.h"
-#include "app/allocator_tuning.h"
-#include "app/reconstruct_job.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
@@ -121,8 +121,8 @@ void PrintRow(const Row& row) {
   if (row.latent_frames > 0) {
     std::snprintf(solve, sizeof(solve), "%d | %.1f s", row.latent_frames, row.wall_s);
   }
-  std::printf("| %s | %s | %s | %s | %.2f | %s | %s |\n", row.data.c_str(),
-              row.method_case.c_str(), row.metric.c_str(), baseline, row.evfs, gain, solve);
+  std::printf("| %s | %s | %s | %s | %.2f | %s | %s |\n", row.data.c_str(), row.method_case.c_str(),
+              row.metric.c_str(), baseline, row.evfs, gain, solve);
   std::fflush(stdout);
 }
 
@@ -139,10 +139,14 @@ Row RunTruthCase(const std::string& snippet, Mode mode, int first, int last, int
   request.method.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
-  Row row{snippet, ModeName(mode), "PSNR dB (frame " + std::to_string(truth) + ")",
-          result.truth.baseline_psnr, result.truth.psnr,
+  Row row{snippet,
+          ModeName(mode),
+          "PSNR dB (frame " + std::to_string(truth) + ")",
+          result.truth.baseline_psnr,
+          result.truth.psnr,
           mode == Mode::kInterpolate ? "blend" : "copy",
-          result.run.video.num_frames(), SecondsSince(start)};
+          result.run.video.num_frames(),
+          SecondsSince(start)};
   return row;
 }
 
@@ -164,8 +168,8 @@ std::vector<Row> RunCupsDeblur(int frame) {
       ScoreDeblurWithoutTruth(result.run.video, result.baseline.frame(0));
   const std::string name = "eslnet_cups_blur #" + std::to_string(frame);
   return {
-      Row{name, "deblur", "mean of latent frames vs input, PSNR dB", 0.0,
-          score.mean_vs_input_psnr, "-", latent_frames, wall_s},
+      Row{name, "deblur", "mean of latent frames vs input, PSNR dB", 0.0, score.mean_vs_input_psnr,
+          "-", latent_frames, wall_s},
       Row{name, "deblur", "variance of Laplacian ×1e3 (mean of latent)",
           1e3 * score.input_sharpness, 1e3 * score.latent_sharpness, "input", latent_frames,
           wall_s},
@@ -242,15 +246,30 @@ std::vector<Row> RunClipInterpolation(const std::string& name, const SimulatedCl
   const int index = result.video.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame));
   const Image& truth = clip.frames.frame(kClipTruthFrame);
   const double blend_psnr = Psnr(InitializeLatentVideo(scene).frame(index), truth);
-  const Row interpolation{name, "interpolate", "PSNR dB (frame 2 from 0, 4)", blend_psnr,
-                          Psnr(result.video.frame(index), truth), "blend",
-                          result.video.num_frames(), SecondsSince(start)};
-  const Row nominal{name, "interpolate",
+  const Row interpolation{name,
+                          "interpolate",
+                          "PSNR dB (frame 2 from 0, 4)",
+                          blend_psnr,
+                          Psnr(result.video.frame(index), truth),
+                          "blend",
+                          result.video.num_frames(),
+                          SecondsSince(start)};
+  const Row nominal{name,
+                    "interpolate",
                     "PSNR dB, per pixel through the crossings at the nominal threshold (oracle)",
-                    blend_psnr, CrossingInterpolationOracle(clip, false), "blend", 0, 0.0};
-  const Row own{name, "interpolate",
+                    blend_psnr,
+                    CrossingInterpolationOracle(clip, false),
+                    "blend",
+                    0,
+                    0.0};
+  const Row own{name,
+                "interpolate",
                 "PSNR dB, per pixel through the crossings at each pixel's threshold (oracle)",
-                blend_psnr, CrossingInterpolationOracle(clip, true), "blend", 0, 0.0};
+                blend_psnr,
+                CrossingInterpolationOracle(clip, true),
+                "blend",
+                0,
+                0.0};
   return {interpolation, nominal, own};
 }
 
@@ -297,13 +316,30 @@ std::vector<Row> RunClipDeblur(const std::string& name, const SimulatedClip& cli
   const Reconstruction result = Reconstruct(scene, Options(), &initial);
   const double blurred_psnr =
       MeanPsnrOverClip(clip, [&blurred](const Image&) -> const Image& { return blurred; });
-  const Row deblur{name, "deblur", "PSNR dB (mean over frames 0-7)", blurred_psnr,
-                   ScoreClipDeblur(result.video, clip, Psnr), "blurred",
-                   result.video.num_frames(), SecondsSince(start)};
-  const Row blind{name, "deblur", "PSNR dB, sharp frames at the blurred brightness (oracle)",
-                  blurred_psnr, BrightnessBlindOracle(clip, blurred), "blurred", 0, 0.0};
-  const Row only{name, "deblur", "PSNR dB, blurred frame at each sharp frame's brightness (oracle)",
-                 blurred_psnr, BrightnessOnlyOracle(clip, blurred), "blurred", 0, 0.0};
+  const Row deblur{name,
+                   "deblur",
+                   "PSNR dB (mean over frames 0-7)",
+                   blurred_psnr,
+                   ScoreClipDeblur(result.video, clip, Psnr),
+                   "blurred",
+                   result.video.num_frames(),
+                   SecondsSince(start)};
+  const Row blind{name,
+                  "deblur",
+                  "PSNR dB, sharp frames at the blurred brightness (oracle)",
+                  blurred_psnr,
+                  BrightnessBlindOracle(clip, blurred),
+                  "blurred",
+                  0,
+                  0.0};
+  const Row only{name,
+                 "deblur",
+                 "PSNR dB, blurred frame at each sharp frame's brightness (oracle)",
+                 blurred_psnr,
+                 BrightnessOnlyOracle(clip, blurred),
+                 "blurred",
+                 0,
+                 0.0};
   return {deblur, blind, only};
 }
 
@@ -312,8 +348,9 @@ int Main() {
     std::fprintf(stderr, "no data folder '%s': pass --data=../shared/data\n", FLAGS_data.c_str());
     return 2;
   }
-  std::printf("| data | case | metric | baseline | evfs | gain | latent frames | wall |\n"
-              "|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| data | case | metric | baseline | evfs | gain | latent frames | wall |\n"
+      "|---|---|---|---|---|---|---|---|\n");
   std::vector<Row> rows;
   const auto add = [&rows](const Row& row) {
     PrintRow(row);
@@ -335,9 +372,9 @@ int Main() {
     std::ofstream csv(FLAGS_csv);
     csv << "data,case,metric,baseline_name,baseline,evfs,latent_frames,wall_s\n";
     for (const Row& row : rows) {
-      csv << row.data << "," << row.method_case << ",\"" << row.metric << "\","
-          << row.baseline_name << "," << row.baseline << "," << row.evfs << ","
-          << row.latent_frames << "," << row.wall_s << "\n";
+      csv << row.data << "," << row.method_case << ",\"" << row.metric << "\"," << row.baseline_name
+          << "," << row.baseline << "," << row.evfs << "," << row.latent_frames << "," << row.wall_s
+          << "\n";
     }
   }
   return 0;

@@ -53,13 +53,13 @@ class InvalidArgumentError : public Error {
 class InputError : public Error {
  public:
   enum class Kind {
-    kMissingFile,      // the file or folder does not exist or cannot be opened
-    kMalformed,        // a line or record does not parse (field count, number, truncation)
-    kOutOfRange,       // a value parses but is outside what is allowed (coordinates, polarity)
-    kNotMonotonic,     // timestamps going backwards
-    kSizeMismatch,     // an image of another size than the sensor
-    kEmptyWindow,      // a requested time window or index range holds nothing
-    kUnwritable,       // an output path cannot be written
+    kMissingFile,   // the file or folder does not exist or cannot be opened
+    kMalformed,     // a line or record does not parse (field count, number, truncation)
+    kOutOfRange,    // a value parses but is outside what is allowed (coordinates, polarity)
+    kNotMonotonic,  // timestamps going backwards
+    kSizeMismatch,  // an image of another size than the sensor
+    kEmptyWindow,   // a requested time window or index range holds nothing
+    kUnwritable,    // an output path cannot be written
   };
 
   /// `line` is 1-based; 0 means the error is about the file as a whole.

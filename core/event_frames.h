@@ -14,11 +14,11 @@ namespace evfs {
 
 /// Where one event frame sits on the latent timeline and which events it holds.
 struct EventFrameSpan {
-  int latent_first = 0;       // first latent frame of the span (H_a)
-  int latent_last = 1;        // last latent frame of the span (H_b), > latent_first
-  int64_t t_first_ns = 0;     // time of the first event in the frame (window start if empty)
-  int64_t t_last_ns = 0;      // time of the last event in the frame (window start if empty)
-  int64_t num_events = 0;     // events binned into this frame
+  int latent_first = 0;    // first latent frame of the span (H_a)
+  int latent_last = 1;     // last latent frame of the span (H_b), > latent_first
+  int64_t t_first_ns = 0;  // time of the first event in the frame (window start if empty)
+  int64_t t_last_ns = 0;   // time of the last event in the frame (window start if empty)
+  int64_t num_events = 0;  // events binned into this frame
 };
 
 class EventFrames {

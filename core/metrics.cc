@@ -16,10 +16,10 @@ constexpr double kSsimK2 = 0.03;
 
 void CheckSameSize(const Image& a, const Image& b, const char* metric) {
   if (a.rows() != b.rows() || a.cols() != b.cols() || a.size() == 0) {
-    throw InvalidArgumentError(std::string(metric) + ": images must be non-empty and of one size, got " +
-                               std::to_string(a.cols()) + "x" + std::to_string(a.rows()) +
-                               " and " + std::to_string(b.cols()) + "x" +
-                               std::to_string(b.rows()));
+    throw InvalidArgumentError(std::string(metric) +
+                               ": images must be non-empty and of one size, got " +
+                               std::to_string(a.cols()) + "x" + std::to_string(a.rows()) + " and " +
+                               std::to_string(b.cols()) + "x" + std::to_string(b.rows()));
   }
 }
 

@@ -3,10 +3,9 @@
 #ifndef EVFS_CORE_VIDEO_H_
 #define EVFS_CORE_VIDEO_H_
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace evfs {
 

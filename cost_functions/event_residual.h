@@ -13,8 +13,8 @@
 #include <ceres/sized_cost_function.h>
 #include <glog/logging.h>
 
-#include "scene/event_model.h"
 #include "cost_functions/scalar_parameter_blocks.h"
+#include "scene/event_model.h"
 
 namespace evfs {
 
@@ -58,9 +58,7 @@ struct EventResidual {
 /// can use its fixed-size autodiff.
 struct OneStepEventResidual {
   OneStepEventResidual(double event_value, const EventModelParams& params)
-      : event_value(event_value),
-        params(params),
-        saturation(SaturationForCount(event_value, 1)) {
+      : event_value(event_value), params(params), saturation(SaturationForCount(event_value, 1)) {
     CheckEventModelParams(params);
   }
 

@@ -102,8 +102,8 @@ int64_t CountCollisionFrames(const EventStream& events, int64_t t_begin_ns, int6
   return static_cast<int64_t>(current) + 1;
 }
 
-PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns,
-                                   int64_t t_end_ns, double hot_pixel_factor) {
+PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                                   double hot_pixel_factor) {
   const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "MeasurePixelActivity");
   PixelActivity activity;
   activity.num_events = static_cast<int64_t>(range.last - range.first);
@@ -201,9 +201,8 @@ bool StackedBinningOptions::IsValid(std::string* error) const {
   OptionChecker check;
   check.InRange("num_frames", num_frames, 1, std::numeric_limits<int>::max())
       .InRange("steps_per_frame", steps_per_frame, 1, std::numeric_limits<int>::max())
-      .InRange("num_frames * steps_per_frame",
-               static_cast<long long>(num_frames) * steps_per_frame, 1,
-               std::numeric_limits<int>::max() - 1)
+      .InRange("num_frames * steps_per_frame", static_cast<long long>(num_frames) * steps_per_frame,
+               1, std::numeric_limits<int>::max() - 1)
       .Require(split == Split::kEqualTime || split == Split::kEqualCount, "split",
                "kEqualTime or kEqualCount");
   return check.Passed(error);

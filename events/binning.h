@@ -61,8 +61,8 @@ struct PixelActivity {
 /// a single pixel firing nothing is hot: there is no scene to compare it with.
 /// hot_pixel_factor <= 0 finds none. O(events + pixels) time, one int32 per pixel. Throws as
 /// BinByCollision does for a bad window or bad events.
-PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns,
-                                   int64_t t_end_ns, double hot_pixel_factor);
+PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                                   double hot_pixel_factor);
 
 /// The events of `events` except those at `pixels` (row-major indices, ascending); same sensor.
 EventStream WithoutPixels(const EventStream& events, const std::vector<int32_t>& pixels);

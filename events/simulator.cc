@@ -37,8 +37,7 @@ std::vector<double> DrawThresholds(double nominal, double sigma, size_t count, R
 
 /// Expected background noise events of `num_pixels` pixels over `interval_ns`, in double: the
 /// product overflows int64 for absurd rates, and it is only compared.
-double ExpectedNoiseEvents(const SimulatorOptions& options, double num_pixels,
-                           double interval_ns) {
+double ExpectedNoiseEvents(const SimulatorOptions& options, double num_pixels, double interval_ns) {
   return options.noise_rate_hz * num_pixels * interval_ns / kNanosecondsPerSecond;
 }
 
@@ -47,9 +46,9 @@ void CheckEventBudget(const SimulatorOptions& options, double expected, const st
   if (expected > static_cast<double>(options.max_events)) {
     char count[32];
     std::snprintf(count, sizeof(count), "%.3g", expected);
-    throw InvalidArgumentError("simulator: " + what + " " + count +
-                               " events, more than max_events = " +
-                               std::to_string(options.max_events));
+    throw InvalidArgumentError(
+        "simulator: " + what + " " + count +
+        " events, more than max_events = " + std::to_string(options.max_events));
   }
 }
 

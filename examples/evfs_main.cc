@@ -9,29 +9,28 @@
 //
 // Flags are read here and nowhere else; every failure that is the user's (a bad file, a bad
 // flag) prints one line and exits with status 2.
+#include <gflags/gflags.h>
+#include <glog/logging.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <gflags/gflags.h>
-#include <glog/logging.h>
-
-#include "core/error.h"
-#include "core/time.h"
-#include "events/binning.h"
-#include "events/simulator.h"
 #include "app/allocator_tuning.h"
 #include "app/crash_guard.h"
 #include "app/demo.h"
 #include "app/progress.h"
 #include "app/reconstruct_job.h"
+#include "core/error.h"
+#include "core/time.h"
+#include "events/binning.h"
+#include "events/simulator.h"
 #include "io/aedat4.h"
 #include "io/data_source.h"
 #include "io/frame_list.h"
@@ -42,13 +41,16 @@
 #include "scene/scene.h"
 
 // Input and output.
-DEFINE_string(data, "", "Data folder (Event Camera Dataset layout), HDF5 event file or AEDAT 4 "
+DEFINE_string(data, "",
+              "Data folder (Event Camera Dataset layout), HDF5 event file or AEDAT 4 "
               "recording (.aedat4, from iniVation DV).");
 DEFINE_string(frames, "", "simulate: folder with images.txt ('t path' lines) and the frames.");
-DEFINE_string(out, "", "Output folder (reconstruct, simulate, demo) or file (convert to .h5 or .aedat4): "
+DEFINE_string(out, "",
+              "Output folder (reconstruct, simulate, demo) or file (convert to .h5 or .aedat4): "
               "a new one, or an earlier output of the same command with --overwrite. Never "
               "the root, current or home folder, nor the input or a folder around it.");
-DEFINE_bool(overwrite, false, "Replace --out when it holds an earlier output of the same command "
+DEFINE_bool(overwrite, false,
+            "Replace --out when it holds an earlier output of the same command "
             "(marked by OUT/.evfs-output, or an .h5/.aedat4 file evfs wrote); nothing else is "
             "replaced.");
 // Which frames.
@@ -58,16 +60,20 @@ DEFINE_int32(last, -1,
              "(default first + 1); info: with --first, the window to describe.");
 DEFINE_int32(truth, -1, "Frame to score the reconstruction against (PSNR, SSIM); -1: none.");
 DEFINE_string(mode, "", "interpolate | predict | deblur.");
-DEFINE_double(exposure_s, 0.0, "deblur: exposure around the frame's timestamp, when the data "
+DEFINE_double(exposure_s, 0.0,
+              "deblur: exposure around the frame's timestamp, when the data "
               "has no exposures.txt.");
-DEFINE_double(fps, 0.0, "Resample the latent video to this uniform frame rate; 0 writes the "
+DEFINE_double(fps, 0.0,
+              "Resample the latent video to this uniform frame rate; 0 writes the "
               "latent frames themselves.");
 // Method.
-DEFINE_string(solver, "ceres_lm", "Method: ceres_lm (default: Levenberg-Marquardt in Ceres) | "
+DEFINE_string(solver, "ceres_lm",
+              "Method: ceres_lm (default: Levenberg-Marquardt in Ceres) | "
               "ceres_lbfgs | adam (the paper's optimiser and schedule, true l1) | adam_smooth "
               "(the same on the smoothed objective) | blend | copy | integrate | cf | edi "
               "(classical baselines).");
-DEFINE_bool(checkpoints, false, "Record cost (and PSNR/SSIM against --truth) at every iteration "
+DEFINE_bool(checkpoints, false,
+            "Record cost (and PSNR/SSIM against --truth) at every iteration "
             "of an iterative solver into summary.json.");
 DEFINE_int32(adam_iterations, evfs::AdamOptions().max_iterations, "adam, adam_smooth: steps.");
 DEFINE_double(adam_learning_rate, evfs::AdamOptions().learning_rate,
@@ -80,11 +86,13 @@ DEFINE_double(blur_sigma_px, evfs::BaselineOptions().blur_sigma_px,
 DEFINE_double(cf_cutoff_rad_per_s, evfs::BaselineOptions().cutoff_rad_per_s,
               "cf: crossover frequency of the complementary filter.");
 // Binning.
-DEFINE_string(binning, "auto", "auto | collision | stacked. auto: collision binning (the "
+DEFINE_string(binning, "auto",
+              "auto | collision | stacked. auto: collision binning (the "
               "paper's), unless it gives more than --max_latent_frames frames or "
               "--max_latent_voxels voxels; collision or stacked beyond --max_latent_voxels is "
               "refused.");
-DEFINE_int32(max_latent_frames, evfs::BinningOptions().max_latent_frames, "auto binning: most latent steps before switching to "
+DEFINE_int32(max_latent_frames, evfs::BinningOptions().max_latent_frames,
+             "auto binning: most latent steps before switching to "
              "stacked equal-time binning with this many frames.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "Most pixels x latent frames, decided from event counts before anything is "
@@ -93,27 +101,37 @@ DEFINE_double(hot_pixel_factor, evfs::BinningOptions().hot_pixel_factor,
               "Leave out the events of hot pixels: those firing more than this many times as "
               "often as the window's busy pixels (the busiest outside the top 1 %); 0 keeps "
               "every event.");
-DEFINE_int32(stacked_frames, evfs::BinningOptions().stacked.num_frames, "stacked binning: number of event frames.");
+DEFINE_int32(stacked_frames, evfs::BinningOptions().stacked.num_frames,
+             "stacked binning: number of event frames.");
 // Objective.
 DEFINE_double(frame_weight, evfs::ObjectiveOptions().frame_weight, "Weight of the frame term.");
-DEFINE_double(event_weight, evfs::ObjectiveOptions().event_weight, "lambda_e: weight of the event term.");
-DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight, "lambda_xy: weight of spatial total variation.");
-DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight, "lambda_t: weight of temporal total variation.");
-DEFINE_double(alpha, 0.0, "alpha of tanh(alpha * dg); 0 derives it from the data's contrast "
+DEFINE_double(event_weight, evfs::ObjectiveOptions().event_weight,
+              "lambda_e: weight of the event term.");
+DEFINE_double(spatial_tv_weight, evfs::ObjectiveOptions().spatial_tv_weight,
+              "lambda_xy: weight of spatial total variation.");
+DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight,
+              "lambda_t: weight of temporal total variation.");
+DEFINE_double(alpha, 0.0,
+              "alpha of tanh(alpha * dg); 0 derives it from the data's contrast "
               "threshold (printed).");
 DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_model.model),
               "log (g(x) = log(x + b), paper Eq. 1) | linear (g(x) = x, paper Eq. 2).");
-DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset, "b of the log event model.");
-DEFINE_string(spatial_tv, "anisotropic", "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | "
+DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset,
+              "b of the log event model.");
+DEFINE_string(spatial_tv, "anisotropic",
+              "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | "
               "isotropic (sqrt(dx^2+dy^2)).");
-DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale, "epsilon of the smoothed l1: sqrt(eps^2 + r^2) - eps.");
+DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale,
+              "epsilon of the smoothed l1: sqrt(eps^2 + r^2) - eps.");
 DEFINE_bool(bounds, true, "Keep intensities in [0, 1].");
-DEFINE_int32(activity_radius_px, evfs::ReconstructionOptions().activity_radius_px, "Solve only pixels within this distance of an event of the "
+DEFINE_int32(activity_radius_px, evfs::ReconstructionOptions().activity_radius_px,
+             "Solve only pixels within this distance of an event of the "
              "window; the others keep their initial value. -1 solves every pixel.");
 DEFINE_string(init, evfs::InitializationName(evfs::MethodOptions().initialization),
               "Where the solve starts: blend (the frames blended in time) | events (event "
               "integration from a sharp frame, else EDI for a blurred one).");
-DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps, "Hold a pixel "
+DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
+            "Hold a pixel "
             "constant between the latent steps where it fired (one unknown per quiet run); "
             "false: one unknown per voxel.");
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
@@ -123,29 +141,41 @@ DEFINE_string(smoothing_continuation, "",
               "Comma-separated smoothing scales solved first, each starting the next, before "
               "--smoothing_scale (e.g. 0.2,0.1); empty: one solve.");
 // Ceres.
-DEFINE_string(linear_solver, "CGNR", "Ceres linear solver: CGNR | SPARSE_NORMAL_CHOLESKY | "
+DEFINE_string(linear_solver, "CGNR",
+              "Ceres linear solver: CGNR | SPARSE_NORMAL_CHOLESKY | "
               "ITERATIVE_SCHUR | DENSE_QR ...");
 DEFINE_string(preconditioner, "JACOBI", "Ceres preconditioner: JACOBI | IDENTITY | ...");
-DEFINE_double(eta, evfs::DefaultSolverOptions().eta, "Inexact Newton forcing sequence: CG stops at relative residual eta.");
-DEFINE_int32(max_iterations, evfs::DefaultSolverOptions().max_num_iterations, "Most Levenberg-Marquardt iterations.");
-DEFINE_int32(max_linear_iterations, evfs::DefaultSolverOptions().max_linear_solver_iterations, "Most CG iterations per LM step.");
+DEFINE_double(eta, evfs::DefaultSolverOptions().eta,
+              "Inexact Newton forcing sequence: CG stops at relative residual eta.");
+DEFINE_int32(max_iterations, evfs::DefaultSolverOptions().max_num_iterations,
+             "Most Levenberg-Marquardt iterations.");
+DEFINE_int32(max_linear_iterations, evfs::DefaultSolverOptions().max_linear_solver_iterations,
+             "Most CG iterations per LM step.");
 DEFINE_double(max_time_s, 1e6, "Stop the solve after this many seconds.");
 DEFINE_int32(bounds_line_search_iterations,
              evfs::DefaultSolverOptions().max_num_line_search_step_size_iterations,
              "Steps of Ceres' projected line search after each bounded trust-region step "
              "(0: none; the step is only projected onto the bounds).");
-DEFINE_double(function_tolerance, evfs::DefaultSolverOptions().function_tolerance, "Stop when the relative cost change falls below this.");
-DEFINE_int32(threads, evfs::DefaultSolverOptions().num_threads, "Threads for Jacobian evaluation and the linear solver.");
-DEFINE_bool(progress, false, "Print a line per solver iteration even when stderr is not a "
+DEFINE_double(function_tolerance, evfs::DefaultSolverOptions().function_tolerance,
+              "Stop when the relative cost change falls below this.");
+DEFINE_int32(threads, evfs::DefaultSolverOptions().num_threads,
+             "Threads for Jacobian evaluation and the linear solver.");
+DEFINE_bool(progress, false,
+            "Print a line per solver iteration even when stderr is not a "
             "terminal (it slows a solve split into independent parts).");
-DEFINE_double(progress_interval_s, 5.0, "While a command runs, a line on stderr (stage, "
+DEFINE_double(progress_interval_s, 5.0,
+              "While a command runs, a line on stderr (stage, "
               "iteration, elapsed time) every this many seconds, terminal or not; 0: none.");
 // Simulator.
-DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos, "simulate: ON contrast threshold (log intensity).");
-DEFINE_double(threshold_neg, evfs::SimulatorOptions().contrast_threshold_neg, "simulate: OFF contrast threshold (log intensity).");
-DEFINE_double(threshold_sigma, evfs::SimulatorOptions().threshold_sigma, "simulate: per-pixel spread (std dev) of the thresholds.");
+DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos,
+              "simulate: ON contrast threshold (log intensity).");
+DEFINE_double(threshold_neg, evfs::SimulatorOptions().contrast_threshold_neg,
+              "simulate: OFF contrast threshold (log intensity).");
+DEFINE_double(threshold_sigma, evfs::SimulatorOptions().threshold_sigma,
+              "simulate: per-pixel spread (std dev) of the thresholds.");
 DEFINE_double(refractory_s, 0.0, "simulate: refractory period in seconds.");
-DEFINE_double(noise_rate_hz, evfs::SimulatorOptions().noise_rate_hz, "simulate: background noise events per pixel per second.");
+DEFINE_double(noise_rate_hz, evfs::SimulatorOptions().noise_rate_hz,
+              "simulate: background noise events per pixel per second.");
 DEFINE_uint64(seed, evfs::SimulatorOptions().seed, "simulate: random seed.");
 
 namespace evfs {
@@ -217,13 +247,13 @@ void PrintWindow(const DataSource& source, int first, int last) {
           (activity.hot_pixels.size() == 1 ? "" : "s") + " (" +
           std::to_string(activity.hot_pixel_events) + " events left out)";
   }
-  std::printf("window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %lld pixels "
-              "(%.1f %%), %lld collision frames%s\n",
-              first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(), positive,
-              window.size() - positive, static_cast<long long>(activity.pixels_fired),
-              100.0 * static_cast<double>(activity.pixels_fired) /
-                  static_cast<double>(plan.pixels),
-              static_cast<long long>(plan.collision_frames), hot.c_str());
+  std::printf(
+      "window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %lld pixels "
+      "(%.1f %%), %lld collision frames%s\n",
+      first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(), positive,
+      window.size() - positive, static_cast<long long>(activity.pixels_fired),
+      100.0 * static_cast<double>(activity.pixels_fired) / static_cast<double>(plan.pixels),
+      static_cast<long long>(plan.collision_frames), hot.c_str());
   const bool collision = plan.method == BinningOptions::Method::kCollision;
   std::printf("binning     %s: %s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
               FLAGS_binning.c_str(), collision ? "collision" : "stacked", plan.num_event_frames,
@@ -233,8 +263,8 @@ void PrintWindow(const DataSource& source, int first, int last) {
   // event records is outside the per-pixel event model; this line shows it.
   const double first_mean = source.ReadImage(first).mean();
   const double last_mean = source.ReadImage(last).mean();
-  std::printf("brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", first,
-              first_mean, last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
+  std::printf("brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", first, first_mean,
+              last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
 }
 
 int RunInfo() {
@@ -248,8 +278,10 @@ int RunInfo() {
                 static_cast<long long>(events.positive),
                 static_cast<long long>(events.count - events.positive));
   } else {
-    std::printf("events      none: frames only (make events with 'evfs simulate --frames=%s "
-                "--out=DIR')\n", source->path().c_str());
+    std::printf(
+        "events      none: frames only (make events with 'evfs simulate --frames=%s "
+        "--out=DIR')\n",
+        source->path().c_str());
   }
   if (events.count > 0) {
     const double span_s = NanosecondsToSeconds(events.t_last_ns - events.t_first_ns);
@@ -267,11 +299,10 @@ int RunInfo() {
     std::printf("  %3zu  t=%.6f s  %s", i, NanosecondsToSeconds(frames[i].t_ns),
                 frames[i].path.c_str());
     if (frames[i].has_exposure) {
-      std::printf("  exposure %.6f .. %.6f s (%.1f ms)",
-                  NanosecondsToSeconds(frames[i].exposure_begin_ns),
-                  NanosecondsToSeconds(frames[i].exposure_end_ns),
-                  1e3 * NanosecondsToSeconds(frames[i].exposure_end_ns -
-                                             frames[i].exposure_begin_ns));
+      std::printf(
+          "  exposure %.6f .. %.6f s (%.1f ms)", NanosecondsToSeconds(frames[i].exposure_begin_ns),
+          NanosecondsToSeconds(frames[i].exposure_end_ns),
+          1e3 * NanosecondsToSeconds(frames[i].exposure_end_ns - frames[i].exposure_begin_ns));
     }
     std::printf("\n");
   }
@@ -319,13 +350,14 @@ int RunSimulate() {
 
   const std::filesystem::path folder(FLAGS_frames);
   std::vector<FrameInfo> frames = ReadFrameList((folder / "images.txt").string());
-  Require(frames.size() >= 2, (folder / "images.txt").string() + ": simulate needs at least 2 frames");
+  Require(frames.size() >= 2,
+          (folder / "images.txt").string() + ": simulate needs at least 2 frames");
   Video video;
   std::vector<Image> images;
   for (const FrameInfo& frame : frames) {
     images.push_back(ReadGreyImage((folder / frame.path).string()));
-    if (!video.empty() && (images.back().rows() != video.height() ||
-                           images.back().cols() != video.width())) {
+    if (!video.empty() &&
+        (images.back().rows() != video.height() || images.back().cols() != video.width())) {
       throw InputError(InputError::Kind::kSizeMismatch, (folder / frame.path).string(), 0,
                        "expected a " + std::to_string(video.width()) + "x" +
                            std::to_string(video.height()) + " image like the first frame");
@@ -436,10 +468,9 @@ int RunReconstruct(ProgressReporter* progress) {
   out.Commit();
 
   const MethodResult& run = result.run;
-  std::printf("%s: %dx%d, %lld events, %d event frames, %d latent frames\n",
-              ModeName(result.mode), result.width, result.height,
-              static_cast<long long>(result.events), result.event_frames,
-              run.video.num_frames());
+  std::printf("%s: %dx%d, %lld events, %d event frames, %d latent frames\n", ModeName(result.mode),
+              result.width, result.height, static_cast<long long>(result.events),
+              result.event_frames, run.video.num_frames());
   if (result.hot_pixels > 0) {
     std::printf("hot pixels: %d, their %lld events left out (--hot_pixel_factor)\n",
                 result.hot_pixels, static_cast<long long>(result.hot_pixel_events));
@@ -447,9 +478,9 @@ int RunReconstruct(ProgressReporter* progress) {
   if (IsIterative(request.method.method)) {
     std::printf("model: %s\n", run.reconstruction.model.description.c_str());
     if (run.solved) {
-      std::printf("solve: %s from %s, %d iterations, cost %.6g -> %.6g (%s)\n",
-                  run.method.c_str(), run.initialization.c_str(), run.iterations,
-                  run.initial_cost, run.final_cost, run.message.c_str());
+      std::printf("solve: %s from %s, %d iterations, cost %.6g -> %.6g (%s)\n", run.method.c_str(),
+                  run.initialization.c_str(), run.iterations, run.initial_cost, run.final_cost,
+                  run.message.c_str());
     } else {
       std::printf("solve: skipped (%s)\n", run.message.c_str());
     }
@@ -459,14 +490,15 @@ int RunReconstruct(ProgressReporter* progress) {
   }
   if (result.has_truth) {
     std::printf("truth: frame %d vs latent %d: PSNR %.2f dB, SSIM %.4f (%s: %.2f dB, %.4f)\n",
-                result.truth.index, result.truth.latent_index, result.truth.psnr,
-                result.truth.ssim, result.mode == Mode::kInterpolate ? "blend" : "copy",
-                result.truth.baseline_psnr, result.truth.baseline_ssim);
+                result.truth.index, result.truth.latent_index, result.truth.psnr, result.truth.ssim,
+                result.mode == Mode::kInterpolate ? "blend" : "copy", result.truth.baseline_psnr,
+                result.truth.baseline_ssim);
   }
-  std::printf("time: read %.2f s, bin %.3f s, build %.2f s, solve %.2f s, write %.2f s, "
-              "total %.2f s\n",
-              result.time.read_s, result.time.bin_s, result.time.build_s, result.time.solve_s,
-              result.time.write_s, result.time.total_s);
+  std::printf(
+      "time: read %.2f s, bin %.3f s, build %.2f s, solve %.2f s, write %.2f s, "
+      "total %.2f s\n",
+      result.time.read_s, result.time.bin_s, result.time.build_s, result.time.solve_s,
+      result.time.write_s, result.time.total_s);
   std::printf("wrote %d frames to %s\n", result.output.num_frames(), out.path().c_str());
   return 0;
 }

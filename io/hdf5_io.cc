@@ -218,12 +218,11 @@ void CheckStored(const H5Context& h5, hid_t dataset, const std::string& name,
   if (type_class == H5T_INTEGER || type_class == H5T_FLOAT) {
     const size_t precision = H5Tget_precision(type.get());
     const int offset = H5Tget_offset(type.get());
-    if (precision == 0 || offset < 0 ||
-        precision + static_cast<size_t>(offset) > 8 * value_bytes) {
-      h5.Fail(InputError::Kind::kMalformed,
-              "corrupt type of " + name + ": " + std::to_string(precision) + " bits at bit offset " +
-                  std::to_string(offset) + " do not fit in " + std::to_string(value_bytes) +
-                  " bytes");
+    if (precision == 0 || offset < 0 || precision + static_cast<size_t>(offset) > 8 * value_bytes) {
+      h5.Fail(InputError::Kind::kMalformed, "corrupt type of " + name + ": " +
+                                                std::to_string(precision) + " bits at bit offset " +
+                                                std::to_string(offset) + " do not fit in " +
+                                                std::to_string(value_bytes) + " bytes");
     }
   }
   // In long double: a corrupt extent can overflow 64 bits.

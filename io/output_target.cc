@@ -6,8 +6,8 @@
 
 #include <climits>
 #include <cstdio>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -89,9 +89,9 @@ std::string MarkerLine(const std::string& command) { return "evfs " + command; }
 // (files keep their extension, which says their format).
 fs::path TaggedSibling(const fs::path& path, const char* tag, bool keep_extension, int n) {
   const std::string unique = std::to_string(::getpid()) + "-" + std::to_string(n);
-  const std::string name = keep_extension ? "." + path.stem().string() + tag + unique +
-                                                path.extension().string()
-                                          : "." + path.filename().string() + tag + unique;
+  const std::string name =
+      keep_extension ? "." + path.stem().string() + tag + unique + path.extension().string()
+                     : "." + path.filename().string() + tag + unique;
   return path.parent_path() / name;
 }
 
@@ -123,9 +123,9 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
     const fs::path protected_folder = Resolved(Normalized(folder.path));
     if (IsSameOrInside(protected_folder, resolved)) {
       Refuse(path, "it is " +
-                       (protected_folder == resolved ? folder.what
-                                                     : "a parent of " + folder.what + " " +
-                                                           protected_folder.string()) +
+                       (protected_folder == resolved
+                            ? folder.what
+                            : "a parent of " + folder.what + " " + protected_folder.string()) +
                        ", which evfs never replaces");
     }
   }
@@ -201,8 +201,8 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
     if (open_errno == EEXIST && attempt < 100) continue;  // a leftover of a killed run
     staging_.clear();
     const std::string reason = std::generic_category().message(open_errno);
-    for (auto created_parent = created_parents_.rbegin();
-         created_parent != created_parents_.rend(); ++created_parent) {
+    for (auto created_parent = created_parents_.rbegin(); created_parent != created_parents_.rend();
+         ++created_parent) {
       fs::remove(*created_parent, error);
     }
     Unwritable(path, "cannot create the output (" + reason + ")");
@@ -245,8 +245,7 @@ void OutputTarget::CheckExisting() const {
     if (fs::is_directory(status)) {
       Refuse(path, "it is a folder ('" + command + "' writes one file there)");
     }
-    if (!fs::is_regular_file(status) || !options_.is_own_file ||
-        !options_.is_own_file(path_)) {
+    if (!fs::is_regular_file(status) || !options_.is_own_file || !options_.is_own_file(path_)) {
       Refuse(path, "the file exists and evfs did not write it; name a new file");
     }
   }
@@ -272,7 +271,8 @@ void OutputTarget::Commit() {
   std::error_code error;
   if (is_file || !fs::exists(fs::symlink_status(path, error))) {
     fs::rename(staging_, path, error);  // a file replaces an earlier file atomically
-    if (error) Unwritable(path, "cannot move the finished output into place (" + error.message() + ")");
+    if (error)
+      Unwritable(path, "cannot move the finished output into place (" + error.message() + ")");
     committed_ = true;
     cleanup_.reset();
     return;

@@ -125,7 +125,8 @@ const EventTextReader& TextFolderDataSource::events() const {
   if (!events_) {
     throw InputError(InputError::Kind::kMissingFile, (fs::path(path_) / kEventsFile).string(), 0,
                      "this folder holds frames only; make events for it with "
-                     "'evfs simulate --frames=" + path_ + " --out=DIR'");
+                     "'evfs simulate --frames=" +
+                         path_ + " --out=DIR'");
   }
   return *events_;
 }

@@ -1,7 +1,6 @@
 #include "scene/activity_mask.h"
 
 #include <algorithm>
-
 #include <opencv2/imgproc.hpp>
 
 namespace evfs {

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <vector>
 
-
 namespace evfs {
 namespace {
 
@@ -32,8 +31,7 @@ std::vector<double> NetEventCount(const Scene& scene, int first, int last) {
 
 bool EventModelEstimationOptions::IsValid(std::string* error) const {
   if (!(alpha_times_change > 0.0) || !(assumed_contrast_threshold > 0.0) ||
-      !(assumed_linear_change > 0.0) ||
-      min_pixels < 1) {
+      !(assumed_linear_change > 0.0) || min_pixels < 1) {
     if (error) *error = "event model estimation options must be positive";
     return false;
   }

@@ -41,8 +41,8 @@ BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t e
     case BinningOptions::Method::kCollision:
       if (collision_latent_frames > max_latent_frames) {
         throw InvalidArgumentError(
-            "collision binning gives " + VoxelCount(collision_latent_frames, plan.pixels) +
-            limit + " (auto binning falls back to stacked frames; or raise the limit)");
+            "collision binning gives " + VoxelCount(collision_latent_frames, plan.pixels) + limit +
+            " (auto binning falls back to stacked frames; or raise the limit)");
       }
       plan.method = BinningOptions::Method::kCollision;
       break;
@@ -59,8 +59,7 @@ BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t e
       break;
     }
     case BinningOptions::Method::kAuto: {
-      const int64_t max_steps =
-          std::min<int64_t>(binning.max_latent_frames, max_latent_frames - 1);
+      const int64_t max_steps = std::min<int64_t>(binning.max_latent_frames, max_latent_frames - 1);
       if (max_steps < 1) {
         throw InvalidArgumentError("the " + std::to_string(events.width()) + "x" +
                                    std::to_string(events.height()) + " sensor needs at least " +
@@ -110,8 +109,8 @@ bool BinningOptions::IsValid(std::string* error) const {
   return method != Method::kStacked || stacked.IsValid(error);
 }
 
-BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns,
-                        int64_t window_end_ns, const BinningOptions& binning) {
+BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
+                        const BinningOptions& binning) {
   EventStream kept;
   return PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept);
 }
@@ -160,10 +159,9 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
           NearestLatent(latent_ns, frame.exposure_begin_ns);
     } else {
       // A blurred frame averages every latent frame inside its exposure (at least one).
-      const auto first = std::lower_bound(latent_ns.begin(), latent_ns.end(),
-                                          frame.exposure_begin_ns);
-      const auto last = std::upper_bound(latent_ns.begin(), latent_ns.end(),
-                                         frame.exposure_end_ns);
+      const auto first =
+          std::lower_bound(latent_ns.begin(), latent_ns.end(), frame.exposure_begin_ns);
+      const auto last = std::upper_bound(latent_ns.begin(), latent_ns.end(), frame.exposure_end_ns);
       if (first >= last) {
         observation.latent_first = observation.latent_last =
             NearestLatent(latent_ns, (frame.exposure_begin_ns + frame.exposure_end_ns) / 2);
@@ -179,19 +177,17 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
 
 Scene MakeInterpolationScene(const TimedFrame& first, const TimedFrame& last,
                              const EventStream& events, const BinningOptions& binning) {
-  return MakeScene({first, last}, events, first.exposure_begin_ns, last.exposure_end_ns,
-                   binning);
+  return MakeScene({first, last}, events, first.exposure_begin_ns, last.exposure_end_ns, binning);
 }
 
-Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns,
-                          const EventStream& events, const BinningOptions& binning) {
+Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns, const EventStream& events,
+                          const BinningOptions& binning) {
   return MakeScene({first}, events, first.exposure_begin_ns, window_end_ns, binning);
 }
 
 Scene MakeDeblurScene(const TimedFrame& blurred, const EventStream& events,
                       const BinningOptions& binning) {
-  return MakeScene({blurred}, events, blurred.exposure_begin_ns, blurred.exposure_end_ns,
-                   binning);
+  return MakeScene({blurred}, events, blurred.exposure_begin_ns, blurred.exposure_end_ns, binning);
 }
 
 Video InitializeLatentVideo(const Scene& scene) {

@@ -68,9 +68,9 @@ struct BinningPlan {
   StackedBinningOptions stacked;  // kStacked: the frames and steps used
   int num_event_frames = 0;
   int num_latent_frames = 2;
-  int64_t pixels = 0;             // of the sensor
-  int64_t collision_frames = 0;   // what collision binning gives, hot pixels left out
-  PixelActivity activity;         // hot pixels and counts, before leaving any out
+  int64_t pixels = 0;            // of the sensor
+  int64_t collision_frames = 0;  // what collision binning gives, hot pixels left out
+  PixelActivity activity;        // hot pixels and counts, before leaving any out
 
   int64_t latent_voxels() const { return pixels * num_latent_frames; }
 };
@@ -79,8 +79,8 @@ struct BinningPlan {
 /// InvalidArgumentError, naming the option to change, when the binning asked for would exceed
 /// binning.max_latent_voxels (explicit collision or stacked binning over it, or a sensor on
 /// which not even one latent step fits), for invalid options, or as the binning functions do.
-BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns,
-                        int64_t window_end_ns, const BinningOptions& binning);
+BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
+                        const BinningOptions& binning);
 
 struct Scene {
   int height = 0;
@@ -94,9 +94,7 @@ struct Scene {
   int64_t hot_pixel_events = 0;
 
   int num_latent_frames() const { return static_cast<int>(events.latent_timestamps_ns().size()); }
-  const std::vector<int64_t>& latent_timestamps_ns() const {
-    return events.latent_timestamps_ns();
-  }
+  const std::vector<int64_t>& latent_timestamps_ns() const { return events.latent_timestamps_ns(); }
 };
 
 /// Builds the general scene: bins `events` over [window_begin_ns, window_end_ns) as PlanBinning
@@ -110,8 +108,8 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
 Scene MakeInterpolationScene(const TimedFrame& first, const TimedFrame& last,
                              const EventStream& events, const BinningOptions& binning);
 /// Prediction: a sharp frame at the start and events up to window_end_ns.
-Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns,
-                          const EventStream& events, const BinningOptions& binning);
+Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns, const EventStream& events,
+                          const BinningOptions& binning);
 /// Motion deblur: one blurred frame whose exposure is the window.
 Scene MakeDeblurScene(const TimedFrame& blurred, const EventStream& events,
                       const BinningOptions& binning);

@@ -22,10 +22,10 @@
 
 #include "core/video.h"
 #include "scene/activity_mask.h"
+#include "scene/scene.h"
 #include "solver/fused_objective.h"
 #include "solver/iteration_callback.h"
 #include "solver/reconstruction_options.h"
-#include "scene/scene.h"
 
 namespace evfs {
 

@@ -5,8 +5,8 @@
 #include <cstring>
 
 #include "core/error.h"
-#include "scene/event_model.h"
 #include "cost_functions/weighted_l1_loss.h"
+#include "scene/event_model.h"
 
 namespace evfs {
 namespace {

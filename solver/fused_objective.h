@@ -25,8 +25,8 @@
 
 #include "core/video.h"
 #include "scene/activity_mask.h"
-#include "solver/reconstruction_options.h"
 #include "scene/scene.h"
+#include "solver/reconstruction_options.h"
 
 namespace evfs {
 

@@ -31,8 +31,8 @@ class LatentLayout {
  public:
   struct Segment {
     int64_t pixel = 0;
-    int first = 0;  // first latent frame
-    int last = 0;   // last latent frame (inclusive)
+    int first = 0;          // first latent frame
+    int last = 0;           // last latent frame (inclusive)
     bool constant = false;  // a ring pixel's segment: held at its initial value
     int length() const { return last - first + 1; }
   };

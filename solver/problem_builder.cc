@@ -178,7 +178,9 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
 
   // Each family's loss is weight / (h·w) times the smoothed |r| (ObjectiveOptions).
   const double per_pixel = 1.0 / static_cast<double>(layout.pixels_per_frame());
-  const auto block = [&](int t, int64_t p) { return layout.value(layout.segment_at(t, p), latent); };
+  const auto block = [&](int t, int64_t p) {
+    return layout.value(layout.segment_at(t, p), latent);
+  };
   using Family = CostFunctionCache::Family;
   std::vector<double*> blocks;
   std::vector<int> shape;
@@ -201,9 +203,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
           }
         }
         const double value = frame.image.data()[p];
-        ceres::CostFunction* cost = cache.Get(Family::kFrame, value, shape, [&] {
-          return FrameResidual::Create(value, shape);
-        });
+        ceres::CostFunction* cost = cache.Get(Family::kFrame, value, shape,
+                                              [&] { return FrameResidual::Create(value, shape); });
         problem.AddResidualBlock(cost, loss, blocks);
         ++statistics.frame_residuals;
       }

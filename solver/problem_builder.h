@@ -2,18 +2,18 @@
 #ifndef EVFS_SOLVER_PROBLEM_BUILDER_H_
 #define EVFS_SOLVER_PROBLEM_BUILDER_H_
 
+#include <ceres/ceres.h>
+
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <utility>
 #include <vector>
 
-#include <ceres/ceres.h>
-
 #include "core/video.h"
+#include "scene/scene.h"
 #include "solver/latent_layout.h"
 #include "solver/reconstruction_options.h"
-#include "scene/scene.h"
 
 namespace evfs {
 

@@ -97,8 +97,9 @@ ReconstructionOptions::ReconstructionOptions() : solver(DefaultSolverOptions()) 
 bool ReconstructionOptions::IsValid(std::string* error) const {
   if (!objective.IsValid(error) || !estimation.IsValid(error)) return false;
   if (bound_intensities && solver.minimizer_type == ceres::LINE_SEARCH) {
-    *error = "Ceres' line-search minimiser cannot keep intensities in [0, 1]: turn the bounds "
-             "off or use the trust-region minimiser";
+    *error =
+        "Ceres' line-search minimiser cannot keep intensities in [0, 1]: turn the bounds "
+        "off or use the trust-region minimiser";
     return false;
   }
   for (const double scale : smoothing_continuation) {

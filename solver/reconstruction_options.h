@@ -3,13 +3,13 @@
 #ifndef EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
 #define EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
 
+#include <ceres/ceres.h>
+
 #include <string>
 #include <vector>
 
-#include <ceres/ceres.h>
-
-#include "scene/event_model.h"
 #include "cost_functions/spatial_tv_residual.h"
+#include "scene/event_model.h"
 #include "scene/event_model_estimation.h"
 
 namespace evfs {

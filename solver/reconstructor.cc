@@ -137,8 +137,8 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   summary.problem = ProblemStatistics();
   summary.problem.parts = 0;
   for (const auto& part : parts) summary.problem += part->statistics();
-  summary.problem.skipped_pixels = static_cast<int64_t>(scene.height) * scene.width -
-                                   summary.problem.active_pixels;
+  summary.problem.skipped_pixels =
+      static_cast<int64_t>(scene.height) * scene.width - summary.problem.active_pixels;
   if (summary.problem.variable_parameter_blocks == 0) {
     summary.skipped_reason = "no unknowns: no pixel is active";
     return;
@@ -198,8 +198,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   int iterations = 0;  // of the part that took most
   for (size_t i = 0; i < parts.size(); ++i) {
     Accumulate(part_summaries[i], i == 0, &summary.ceres);
-    iterations =
-        std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
+    iterations = std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
   }
   summary.iterations += iterations;
   if (summary.ceres.termination_type == ceres::FAILURE) {

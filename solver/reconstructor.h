@@ -2,16 +2,16 @@
 #ifndef EVFS_SOLVER_RECONSTRUCTOR_H_
 #define EVFS_SOLVER_RECONSTRUCTOR_H_
 
-#include <string>
-
 #include <ceres/ceres.h>
+
+#include <string>
 
 #include "core/video.h"
 #include "scene/event_model_estimation.h"
+#include "scene/scene.h"
 #include "solver/iteration_callback.h"
 #include "solver/problem_builder.h"
 #include "solver/reconstruction_options.h"
-#include "scene/scene.h"
 
 namespace evfs {
 
@@ -21,7 +21,7 @@ struct ReconstructionSummary {
   /// summed (stage times are then thread time, not wall time) and the worst termination.
   ceres::Solver::Summary ceres;
   ProblemStatistics problem;
-  EventModelEstimate model;    // the α used, and how it was derived when it was
+  EventModelEstimate model;  // the α used, and how it was derived when it was
   bool alpha_derived = false;
   bool solved = false;         // false when the scene needed no solve
   std::string skipped_reason;  // why not, when solved is false
@@ -40,9 +40,10 @@ struct Reconstruction {
 /// Reconstructs the latent video of `scene`, starting from `initial` (the scene's latent
 /// timeline; e.g. a classical estimate from baselines/) or, when null, from
 /// InitializeLatentVideo(scene). Throws InvalidArgumentError for invalid options or an initial
-/// video of another shape, SolverError when Ceres ends with FAILURE. α <= 0 in the options is derived from the scene first. A scene
-/// without events is answered with its initialisation, without a solve.
-/// `callback`, when given, sees every Ceres iteration with the current latent video.
+/// video of another shape, SolverError when Ceres ends with FAILURE. α <= 0 in the options is
+/// derived from the scene first. A scene without events is answered with its initialisation,
+/// without a solve. `callback`, when given, sees every Ceres iteration with the current latent
+/// video.
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
                            const Video* initial = nullptr,
                            const IterationCallback& callback = nullptr);

@@ -3,13 +3,13 @@
 #ifndef EVFS_TESTS_TEST_DATA_H_
 #define EVFS_TESTS_TEST_DATA_H_
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <string>
 
-#include <gtest/gtest.h>
-
 namespace evfs {
-namespace testing {
+namespace test {
 
 /// The shared data folder, or "" when it is not available.
 inline std::string SharedDataDir() {
@@ -26,15 +26,15 @@ inline std::string ScratchDir(const std::string& name) {
   return dir.string();
 }
 
-}  // namespace testing
+}  // namespace test
 }  // namespace evfs
 
 /// Skips the current test when the shared data folder is absent, saying why.
-#define EVFS_REQUIRE_SHARED_DATA(dir_variable)                                              \
-  const std::string dir_variable = ::evfs::testing::SharedDataDir();                         \
-  if (dir_variable.empty()) {                                                                \
-    GTEST_SKIP() << "shared data folder not found (configure with -DEVFS_DATA_DIR=...); "    \
-                    "skipping a test that reads the real DAVIS snippets";                    \
+#define EVFS_REQUIRE_SHARED_DATA(dir_variable)                                            \
+  const std::string dir_variable = ::evfs::test::SharedDataDir();                         \
+  if (dir_variable.empty()) {                                                             \
+    GTEST_SKIP() << "shared data folder not found (configure with -DEVFS_DATA_DIR=...); " \
+                    "skipping a test that reads the real DAVIS snippets";                 \
   }
 
 #endif  // EVFS_TESTS_TEST_DATA_H_

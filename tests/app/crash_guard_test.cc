@@ -1,8 +1,7 @@
 #include "app/crash_guard.h"
 
-#include <gtest/gtest.h>
-
 #include <glog/logging.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <csignal>
@@ -103,7 +102,7 @@ void UseInternalErrorReporting() {
 // and the unfinished output removed like on any other exit.
 TEST(InternalErrorReporting, AFailedCheckIsOneLineNamingTheCheck) {
   UseInternalErrorReporting();
-  const std::filesystem::path scratch = evfs::testing::ScratchDir("crash_guard_check");
+  const std::filesystem::path scratch = evfs::test::ScratchDir("crash_guard_check");
   const std::filesystem::path unfinished = scratch / ".out.evfs-tmp-1";
   ::testing::internal::CaptureStderr();
   const int status = RunInChildProcess(
@@ -137,7 +136,7 @@ TEST(InternalErrorReporting, OtherLogMessagesStillReachStderr) {
 }
 
 TEST(RunInChildProcess, ACrashOutsideAnHdf5ReadIsAnInternalErrorAndLeavesNothing) {
-  const std::filesystem::path scratch = evfs::testing::ScratchDir("crash_guard_cleanup");
+  const std::filesystem::path scratch = evfs::test::ScratchDir("crash_guard_cleanup");
   const std::filesystem::path unfinished = scratch / ".out.evfs-tmp-1";
   ::testing::internal::CaptureStderr();
   const int status = RunInChildProcess(

@@ -59,8 +59,8 @@ TEST(Baseline, NamesRoundTrip) {
 constexpr double kBlendTolerance = 1e-6;
 
 TEST(Baseline, BlendIsLinearInTimeBetweenTheFramesAndCopyHoldsTheFrame) {
-  const testing::SyntheticRecording recording;
-  const Scene interpolation = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene interpolation = test::InterpolationScene(recording);
   ASSERT_EQ(interpolation.frames.size(), 2u);
   const std::vector<int64_t>& latent_ns = interpolation.latent_timestamps_ns();
   // A sharp frame sits at the centre of its exposure on the latent timeline.
@@ -72,18 +72,17 @@ TEST(Baseline, BlendIsLinearInTimeBetweenTheFramesAndCopyHoldsTheFrame) {
   const Video blend = RunBaseline(BaselineMethod::kBlend, interpolation, BaselineOptions()).video;
   ASSERT_EQ(blend.num_frames(), static_cast<int>(latent_ns.size()));
   for (int k = 0; k < blend.num_frames(); ++k) {
-    const double weight = std::clamp(
-        (static_cast<double>(latent_ns[k]) - centre_ns(first)) / (centre_ns(last) - centre_ns(first)),
-        0.0, 1.0);
+    const double weight = std::clamp((static_cast<double>(latent_ns[k]) - centre_ns(first)) /
+                                         (centre_ns(last) - centre_ns(first)),
+                                     0.0, 1.0);
     const Image expected = (1.0 - weight) * first.image + weight * last.image;
-    EXPECT_LT(testing::MaxAbsDifference(blend.frame(k), expected), kBlendTolerance) << k;
+    EXPECT_LT(test::MaxAbsDifference(blend.frame(k), expected), kBlendTolerance) << k;
   }
-  for (const Scene& scene :
-       {testing::PredictionScene(recording), testing::DeblurScene(recording)}) {
+  for (const Scene& scene : {test::PredictionScene(recording), test::DeblurScene(recording)}) {
     const BaselineResult copy = RunBaseline(BaselineMethod::kCopy, scene, BaselineOptions());
     ASSERT_EQ(copy.video.num_frames(), static_cast<int>(scene.latent_timestamps_ns().size()));
     for (int k = 0; k < copy.video.num_frames(); ++k) {
-      EXPECT_EQ(testing::MaxAbsDifference(copy.video.frame(k), scene.frames[0].image), 0.0) << k;
+      EXPECT_EQ(test::MaxAbsDifference(copy.video.frame(k), scene.frames[0].image), 0.0) << k;
     }
     EXPECT_TRUE(copy.parameters.empty());
     EXPECT_TRUE(copy.threshold_source.empty());
@@ -91,10 +90,9 @@ TEST(Baseline, BlendIsLinearInTimeBetweenTheFramesAndCopyHoldsTheFrame) {
 }
 
 TEST(Baseline, EveryMethodAnswersOnTheScenesLatentTimeline) {
-  const testing::SyntheticRecording recording;
-  for (const Scene& scene :
-       {testing::InterpolationScene(recording), testing::PredictionScene(recording),
-        testing::DeblurScene(recording)}) {
+  const test::SyntheticRecording recording;
+  for (const Scene& scene : {test::InterpolationScene(recording), test::PredictionScene(recording),
+                             test::DeblurScene(recording)}) {
     for (BaselineMethod method : kAllMethods) {
       if (!BaselineSupports(method, scene, nullptr)) continue;
       const Video video = RunBaseline(method, scene, BaselineOptions()).video;
@@ -110,10 +108,10 @@ TEST(Baseline, EveryMethodAnswersOnTheScenesLatentTimeline) {
 }
 
 TEST(Baseline, SaysWhichCasesEachMethodSupports) {
-  const testing::SyntheticRecording recording;
-  const Scene interpolation = testing::InterpolationScene(recording);
-  const Scene prediction = testing::PredictionScene(recording);
-  const Scene deblur = testing::DeblurScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene interpolation = test::InterpolationScene(recording);
+  const Scene prediction = test::PredictionScene(recording);
+  const Scene deblur = test::DeblurScene(recording);
   struct Case {
     BaselineMethod method;
     bool interpolation, prediction, deblur;
@@ -147,8 +145,8 @@ TEST(Baseline, SaysWhichCasesEachMethodSupports) {
 }
 
 TEST(Baseline, RejectsInvalidOptions) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::PredictionScene(recording);
   std::vector<BaselineOptions> invalid(6);
   invalid[0].contrast_threshold = std::numeric_limits<double>::quiet_NaN();
   invalid[1].log_offset = 0.0;
@@ -171,9 +169,9 @@ TEST(Baseline, RejectsInvalidOptions) {
 }
 
 TEST(Baseline, MethodsRejectAThresholdThatIsNotPositive) {
-  const testing::SyntheticRecording recording;
-  const Scene prediction = testing::PredictionScene(recording);
-  const Scene deblur = testing::DeblurScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene prediction = test::PredictionScene(recording);
+  const Scene deblur = test::DeblurScene(recording);
   for (double threshold : {0.0, -0.1, std::numeric_limits<double>::infinity()}) {
     EXPECT_THROW(IntegrateEvents(prediction, BaselineOptions(), threshold), InvalidArgumentError);
     EXPECT_THROW(ComplementaryFilter(prediction, BaselineOptions(), threshold),
@@ -183,8 +181,8 @@ TEST(Baseline, MethodsRejectAThresholdThatIsNotPositive) {
 }
 
 TEST(Baseline, ReportsTheThresholdItUsed) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::InterpolationScene(recording);
   BaselineOptions options;
   options.contrast_threshold = 0.123;
   const BaselineResult given = RunBaseline(BaselineMethod::kIntegrate, scene, options);
@@ -201,16 +199,16 @@ TEST(Baseline, ReportsTheThresholdItUsed) {
   EXPECT_NE(derived.threshold_source.find("measured"), std::string::npos);
 
   // One frame cannot tell: the assumed log threshold.
-  const BaselineResult assumed = RunBaseline(
-      BaselineMethod::kComplementaryFilter, testing::PredictionScene(recording), BaselineOptions());
+  const BaselineResult assumed = RunBaseline(BaselineMethod::kComplementaryFilter,
+                                             test::PredictionScene(recording), BaselineOptions());
   EXPECT_EQ(Parameter(assumed, "contrast_threshold"),
             EventModelEstimationOptions().assumed_contrast_threshold);
   EXPECT_NE(assumed.threshold_source.find("assumed"), std::string::npos);
 }
 
 TEST(Baseline, TuningOnTheTruthRejectsWhatItCannotTune) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::InterpolationScene(recording);
   const Image truth = recording.rendered.frame(10);
   EXPECT_THROW(
       TuneContrastThresholdOnTruth(BaselineMethod::kBlend, scene, BaselineOptions(), truth, 1),
@@ -224,16 +222,15 @@ TEST(Baseline, TuningOnTheTruthRejectsWhatItCannotTune) {
 }
 
 TEST(Baseline, TuningOnTheTruthBeatsTheDerivedThreshold) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::PredictionScene(recording);
   const BaselineResult derived =
       RunBaseline(BaselineMethod::kComplementaryFilter, scene, BaselineOptions());
   const int latent = derived.video.NearestFrame(recording.rendered.timestamp_ns(10));
   const BaselineResult tuned =
       TuneContrastThresholdOnTruth(BaselineMethod::kComplementaryFilter, scene, BaselineOptions(),
                                    recording.rendered.frame(10), latent);
-  EXPECT_GE(testing::PsnrAt(tuned.video, recording, 10),
-            testing::PsnrAt(derived.video, recording, 10));
+  EXPECT_GE(test::PsnrAt(tuned.video, recording, 10), test::PsnrAt(derived.video, recording, 10));
 }
 
 TEST(Baseline, IntegrationWithBlurPredictsSliderDepth) {

@@ -8,7 +8,7 @@
 #include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
-namespace testing {
+namespace test {
 
 /// Rendered frames 0 and 20 with the events between them.
 inline Scene InterpolationScene(const SyntheticRecording& recording) {
@@ -36,7 +36,7 @@ inline double PsnrAt(const Video& video, const SyntheticRecording& recording, in
 /// Largest absolute difference between two images of one size.
 inline double MaxAbsDifference(const Image& a, const Image& b) { return (a - b).abs().maxCoeff(); }
 
-}  // namespace testing
+}  // namespace test
 }  // namespace evfs
 
 #endif  // EVFS_TESTS_BASELINES_BASELINE_TEST_SCENES_H_

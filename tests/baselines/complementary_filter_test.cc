@@ -18,8 +18,8 @@ constexpr double kRoundingTolerance = 1e-9;
 constexpr double kThreshold = 0.2;
 
 TEST(ComplementaryFilter, ZeroCutoffIsForwardLogIntegration) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::PredictionScene(recording);
   BaselineOptions options;
   options.cutoff_rad_per_s = 0.0;
   options.domain = IntegrationDomain::kLog;
@@ -28,27 +28,26 @@ TEST(ComplementaryFilter, ZeroCutoffIsForwardLogIntegration) {
   ASSERT_EQ(filtered.num_frames(), integrated.num_frames());
   EXPECT_EQ(filtered.timestamps_ns(), scene.latent_timestamps_ns());
   for (int t = 0; t < filtered.num_frames(); ++t) {
-    EXPECT_LT(testing::MaxAbsDifference(filtered.frame(t), integrated.frame(t)), kRoundingTolerance)
+    EXPECT_LT(test::MaxAbsDifference(filtered.frame(t), integrated.frame(t)), kRoundingTolerance)
         << t;
   }
 }
 
 TEST(ComplementaryFilter, InfiniteCutoffIsTheFrame) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::PredictionScene(recording);
   BaselineOptions options;
   options.cutoff_rad_per_s = std::numeric_limits<double>::infinity();
   const Video filtered = ComplementaryFilter(scene, options, kThreshold);
   for (int t = 0; t < filtered.num_frames(); ++t) {
-    EXPECT_LT(testing::MaxAbsDifference(filtered.frame(t), scene.frames[0].image),
-              kRoundingTolerance)
+    EXPECT_LT(test::MaxAbsDifference(filtered.frame(t), scene.frames[0].image), kRoundingTolerance)
         << t;
   }
 }
 
 TEST(ComplementaryFilter, AHigherCutoffPullsTheEstimateCloserToTheFrame) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::PredictionScene(recording);
   const int last = scene.num_latent_frames() - 1;
   double previous_distance = std::numeric_limits<double>::infinity();
   for (double cutoff : {0.0, 30.0, 300.0, 3000.0}) {
@@ -64,20 +63,20 @@ TEST(ComplementaryFilter, AHigherCutoffPullsTheEstimateCloserToTheFrame) {
 TEST(ComplementaryFilter, IsCausal) {
   // A frame only acts from its timestamp on: the last frame of an interpolation scene arrives
   // with the last latent frame, after every event, and changes nothing.
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::InterpolationScene(recording);
   Scene other_end = scene;
   other_end.frames[1].image.setConstant(0.5);
   const Video filtered = ComplementaryFilter(scene, BaselineOptions(), kThreshold);
   const Video other = ComplementaryFilter(other_end, BaselineOptions(), kThreshold);
   for (int t = 0; t < filtered.num_frames(); ++t) {
-    EXPECT_EQ(testing::MaxAbsDifference(filtered.frame(t), other.frame(t)), 0.0) << t;
+    EXPECT_EQ(test::MaxAbsDifference(filtered.frame(t), other.frame(t)), 0.0) << t;
   }
 }
 
 TEST(ComplementaryFilter, NeedsAFrame) {
-  const testing::SyntheticRecording recording;
-  Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  Scene scene = test::PredictionScene(recording);
   scene.frames.clear();
   EXPECT_THROW(ComplementaryFilter(scene, BaselineOptions(), kThreshold), InvalidArgumentError);
 }

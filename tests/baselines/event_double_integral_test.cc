@@ -24,8 +24,8 @@ constexpr double kMinGainOverBlurredDb = 2.5;
 constexpr double kSearchToleranceDb = 1e-3;
 
 TEST(EventDoubleIntegral, MeanOfTheLatentFramesOverTheExposureIsTheBlurredFrame) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::DeblurScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::DeblurScene(recording);
   const FrameObservation& blurred = scene.frames[0];
   BaselineOptions options;
   options.clamp_to_unit_range = false;
@@ -36,24 +36,24 @@ TEST(EventDoubleIntegral, MeanOfTheLatentFramesOverTheExposureIsTheBlurredFrame)
     Image mean = Image::Zero(scene.height, scene.width);
     for (int t = blurred.latent_first; t <= blurred.latent_last; ++t) mean += latent.frame(t);
     mean /= blurred.latent_last - blurred.latent_first + 1;
-    EXPECT_LT(testing::MaxAbsDifference(mean, blurred.image), kRoundingTolerance) << threshold;
+    EXPECT_LT(test::MaxAbsDifference(mean, blurred.image), kRoundingTolerance) << threshold;
   }
 }
 
 TEST(EventDoubleIntegral, SharpensASimulatedBlur) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::DeblurScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::DeblurScene(recording);
   const BaselineResult edi = RunBaseline(BaselineMethod::kEdi, scene, BaselineOptions());
   const double blurred = Psnr(scene.frames[0].image, recording.rendered.frame(10));
-  const double deblurred = testing::PsnrAt(edi.video, recording, 10);
+  const double deblurred = test::PsnrAt(edi.video, recording, 10);
   std::printf("deblur of frames 0..20, at frame 10: blurred %.2f dB, edi %.2f dB (c = %.3f)\n",
               blurred, deblurred, edi.parameters[0].value);
   EXPECT_GE(deblurred, blurred + kMinGainOverBlurredDb);
 }
 
 TEST(EventDoubleIntegral, TheCriterionsThresholdMinimisesTheEnergy) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::DeblurScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::DeblurScene(recording);
   const BaselineOptions options;
   const EdiThreshold chosen = ChooseEdiThreshold(scene, options);
   EXPECT_GE(chosen.contrast_threshold, options.threshold_search_min);
@@ -73,22 +73,22 @@ TEST(EventDoubleIntegral, TheCriterionsThresholdMinimisesTheEnergy) {
 }
 
 TEST(EventDoubleIntegral, TheThresholdTunedOnTheTruthScoresAtLeastTheCriterions) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::DeblurScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::DeblurScene(recording);
   const BaselineResult criterion = RunBaseline(BaselineMethod::kEdi, scene, BaselineOptions());
   const int latent = criterion.video.NearestFrame(recording.rendered.timestamp_ns(10));
   const BaselineResult tuned = TuneContrastThresholdOnTruth(
       BaselineMethod::kEdi, scene, BaselineOptions(), recording.rendered.frame(10), latent);
   EXPECT_NE(tuned.threshold_source.find("truth"), std::string::npos);
-  EXPECT_GE(testing::PsnrAt(tuned.video, recording, 10),
-            testing::PsnrAt(criterion.video, recording, 10) - kSearchToleranceDb);
+  EXPECT_GE(test::PsnrAt(tuned.video, recording, 10),
+            test::PsnrAt(criterion.video, recording, 10) - kSearchToleranceDb);
 }
 
 TEST(EventDoubleIntegral, RejectsScenesWithoutExactlyOneBlurredFrame) {
-  const testing::SyntheticRecording recording;
-  EXPECT_THROW(EventDoubleIntegral(testing::PredictionScene(recording), BaselineOptions(), 0.2),
+  const test::SyntheticRecording recording;
+  EXPECT_THROW(EventDoubleIntegral(test::PredictionScene(recording), BaselineOptions(), 0.2),
                InvalidArgumentError);
-  EXPECT_THROW(EventDoubleIntegral(testing::InterpolationScene(recording), BaselineOptions(), 0.2),
+  EXPECT_THROW(EventDoubleIntegral(test::InterpolationScene(recording), BaselineOptions(), 0.2),
                InvalidArgumentError);
 }
 

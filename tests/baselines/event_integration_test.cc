@@ -22,7 +22,7 @@ constexpr double kMinGainOverCopyDb = 5.0;
 
 // Events from the synthetic recording with one threshold at every pixel (no mismatch), so that
 // the simulator's round trip bounds integration with that threshold exactly.
-EventStream EventsWithoutMismatch(const testing::SyntheticRecording& recording,
+EventStream EventsWithoutMismatch(const test::SyntheticRecording& recording,
                                   const SimulatorOptions& simulator) {
   SimulatorOptions exact = simulator;
   exact.threshold_sigma = 0.0;
@@ -30,8 +30,8 @@ EventStream EventsWithoutMismatch(const testing::SyntheticRecording& recording,
 }
 
 TEST(CumulativeEventCount, SumsTheSignedEventsOfTheFramesEndingBeforeEachLatentFrame) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::InterpolationScene(recording);
   const Video count = CumulativeEventCount(scene);
   ASSERT_EQ(count.num_frames(), scene.num_latent_frames());
   EXPECT_EQ(count.timestamps_ns(), scene.latent_timestamps_ns());
@@ -42,11 +42,11 @@ TEST(CumulativeEventCount, SumsTheSignedEventsOfTheFramesEndingBeforeEachLatentF
       for (int x = 0; x < scene.width; ++x) total(y, x) += scene.events.value(k, y, x);
     }
   }
-  EXPECT_EQ(testing::MaxAbsDifference(count.frame(count.num_frames() - 1), total), 0.0);
+  EXPECT_EQ(test::MaxAbsDifference(count.frame(count.num_frames() - 1), total), 0.0);
 }
 
 TEST(CumulativeEventCount, SpreadsAStackedFrameEvenlyOverItsSteps) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   BinningOptions binning;
   binning.method = BinningOptions::Method::kStacked;
   binning.stacked.num_frames = 1;
@@ -60,7 +60,7 @@ TEST(CumulativeEventCount, SpreadsAStackedFrameEvenlyOverItsSteps) {
     for (int x = 0; x < scene.width; ++x) frame(y, x) = scene.events.value(0, y, x);
   }
   for (int t = 0; t <= 4; ++t) {
-    EXPECT_LT(testing::MaxAbsDifference(count.frame(t), frame * (t / 4.0)), kExactTolerance);
+    EXPECT_LT(test::MaxAbsDifference(count.frame(t), frame * (t / 4.0)), kExactTolerance);
   }
 }
 
@@ -68,7 +68,7 @@ TEST(IntegrateEvents, WithTheSensorsThresholdStaysWithinOneThresholdOfTheNextFra
   // The simulator's round trip (events/simulator.h), seen through the scene's event frames:
   // forward log integration with the sensor's threshold and offset lands within one threshold
   // of the frame at the end of the window, at every pixel.
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const SimulatorOptions simulator;
   const Scene scene =
       MakePredictionScene(recording.Sharp(0), recording.rendered.timestamp_ns(10),
@@ -86,43 +86,42 @@ TEST(IntegrateEvents, WithTheSensorsThresholdStaysWithinOneThresholdOfTheNextFra
 }
 
 TEST(IntegrateEvents, PredictsTheNextFrameFarBetterThanTheCopy) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const SimulatorOptions simulator;
-  const Scene scene = testing::PredictionScene(recording);
+  const Scene scene = test::PredictionScene(recording);
   BaselineOptions options;
   options.domain = IntegrationDomain::kLog;
   options.log_offset = simulator.log_eps;
-  const double copy = testing::PsnrAt(InitializeLatentVideo(scene), recording, 10);
-  const double integrated = testing::PsnrAt(
+  const double copy = test::PsnrAt(InitializeLatentVideo(scene), recording, 10);
+  const double integrated = test::PsnrAt(
       IntegrateEvents(scene, options, simulator.contrast_threshold_pos), recording, 10);
   std::printf("prediction of frame 10: copy %.2f dB, integration %.2f dB\n", copy, integrated);
   EXPECT_GE(integrated, copy + kMinGainOverCopyDb);
 }
 
 TEST(IntegrateEvents, ReproducesTheSharpFramesItStartsFrom) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::InterpolationScene(recording);
   const int last = scene.num_latent_frames() - 1;
   for (IntegrationDomain domain : {IntegrationDomain::kLinear, IntegrationDomain::kLog}) {
     BaselineOptions options;
     options.domain = domain;
     options.direction = IntegrationDirection::kBackward;
     const Video backward = IntegrateEvents(scene, options, 0.2);
-    EXPECT_LT(testing::MaxAbsDifference(backward.frame(last), scene.frames[1].image),
-              kExactTolerance);
+    EXPECT_LT(test::MaxAbsDifference(backward.frame(last), scene.frames[1].image), kExactTolerance);
     options.direction = IntegrationDirection::kForward;
     const Video forward = IntegrateEvents(scene, options, 0.2);
-    EXPECT_LT(testing::MaxAbsDifference(forward.frame(0), scene.frames[0].image), kExactTolerance);
+    EXPECT_LT(test::MaxAbsDifference(forward.frame(0), scene.frames[0].image), kExactTolerance);
     options.direction = IntegrationDirection::kBoth;
     const Video both = IntegrateEvents(scene, options, 0.2);
-    EXPECT_LT(testing::MaxAbsDifference(both.frame(0), scene.frames[0].image), kExactTolerance);
-    EXPECT_LT(testing::MaxAbsDifference(both.frame(last), scene.frames[1].image), kExactTolerance);
+    EXPECT_LT(test::MaxAbsDifference(both.frame(0), scene.frames[0].image), kExactTolerance);
+    EXPECT_LT(test::MaxAbsDifference(both.frame(last), scene.frames[1].image), kExactTolerance);
   }
 }
 
 TEST(IntegrateEvents, BothDirectionsBlendForwardAndBackwardLinearlyInTime) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::InterpolationScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::InterpolationScene(recording);
   BaselineOptions options;
   options.domain = IntegrationDomain::kLinear;
   options.clamp_to_unit_range = false;
@@ -138,13 +137,13 @@ TEST(IntegrateEvents, BothDirectionsBlendForwardAndBackwardLinearlyInTime) {
     const double w = static_cast<double>(latent_ns[t] - latent_ns[0]) /
                      static_cast<double>(latent_ns[last] - latent_ns[0]);
     const Image expected = (1.0 - w) * forward.frame(t) + w * backward.frame(t);
-    EXPECT_LT(testing::MaxAbsDifference(both.frame(t), expected), kExactTolerance) << t;
+    EXPECT_LT(test::MaxAbsDifference(both.frame(t), expected), kExactTolerance) << t;
   }
 }
 
 TEST(IntegrateEvents, BlurSmoothsEachIntegratedFrame) {
-  const testing::SyntheticRecording recording;
-  const Scene scene = testing::PredictionScene(recording);
+  const test::SyntheticRecording recording;
+  const Scene scene = test::PredictionScene(recording);
   BaselineOptions options;
   options.clamp_to_unit_range = false;
   const Video sharp = IntegrateEvents(scene, options, 0.1);
@@ -153,14 +152,14 @@ TEST(IntegrateEvents, BlurSmoothsEachIntegratedFrame) {
   for (int t = 0; t < sharp.num_frames(); ++t) {
     Image expected = sharp.frame(t);
     GaussianBlurImage(1.0, &expected);
-    EXPECT_LT(testing::MaxAbsDifference(blurred.frame(t), expected), kExactTolerance);
+    EXPECT_LT(test::MaxAbsDifference(blurred.frame(t), expected), kExactTolerance);
   }
   EXPECT_LT(LaplacianVariance(blurred.frame(0)), LaplacianVariance(sharp.frame(0)));
 }
 
 TEST(IntegrateEvents, NeedsASharpFrame) {
-  const testing::SyntheticRecording recording;
-  EXPECT_THROW(IntegrateEvents(testing::DeblurScene(recording), BaselineOptions(), 0.1),
+  const test::SyntheticRecording recording;
+  EXPECT_THROW(IntegrateEvents(test::DeblurScene(recording), BaselineOptions(), 0.1),
                InvalidArgumentError);
 }
 

@@ -1,10 +1,10 @@
 #include "core/metrics.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -31,7 +31,8 @@ template <typename F>
 Image MakeImage(F f) {
   Image image(kHeight, kWidth);
   for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) image(y, x) = f(static_cast<double>(y), static_cast<double>(x));
+    for (int x = 0; x < kWidth; ++x)
+      image(y, x) = f(static_cast<double>(y), static_cast<double>(x));
   }
   return image;
 }
@@ -46,8 +47,8 @@ Image MakeB() {
 }
 Image MakeC() {
   return MakeImage([](double y, double x) {
-    const double v = 0.5 + 0.4 * std::sin(0.3 * x + 0.2 * y) +
-                     0.1 * std::cos(1.3 * x) * std::sin(0.9 * y);
+    const double v =
+        0.5 + 0.4 * std::sin(0.3 * x + 0.2 * y) + 0.1 * std::cos(1.3 * x) * std::sin(0.9 * y);
     return std::clamp(v, 0.0, 1.0);
   });
 }

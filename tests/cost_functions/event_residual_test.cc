@@ -82,8 +82,8 @@ TEST(EventResidual, NominalCountSaturatesAtTheCountPerStep) {
   const std::unique_ptr<ceres::CostFunction> two_steps(
       EventResidual::Create(-4.0, 2, LinearParams(5.0)));
   const test::Evaluation stacked = test::Evaluate(*two_steps, {0.5, 0.4, 0.2});
-  EXPECT_NEAR(stacked.residuals[0],
-              -4.0 - 2.0 * (std::tanh(-0.5 / 2.0) + std::tanh(-1.0 / 2.0)), kNominalTolerance);
+  EXPECT_NEAR(stacked.residuals[0], -4.0 - 2.0 * (std::tanh(-0.5 / 2.0) + std::tanh(-1.0 / 2.0)),
+              kNominalTolerance);
   // Counts of at most one per step keep the paper's model.
   EXPECT_DOUBLE_EQ(SaturationForCount(-1.0, 1), 1.0);
   EXPECT_DOUBLE_EQ(SaturationForCount(2.0, 4), 1.0);

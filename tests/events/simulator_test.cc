@@ -150,8 +150,7 @@ TEST(EventSimulator, NoiseRateGivesTheExpectedCount) {
 // expected count is known before drawing, so it is refused at once, for the whole video and
 // for one Advance alike.
 TEST(EventSimulator, NoiseBeyondTheEventBudgetIsRefusedBeforeDrawing) {
-  const Video video =
-      ConstantVideo(Image::Constant(32, 32, 0.5), 3, kNanosecondsPerSecond / 10);
+  const Video video = ConstantVideo(Image::Constant(32, 32, 0.5), 3, kNanosecondsPerSecond / 10);
   SimulatorOptions options;
   options.noise_rate_hz = 1e12;
   try {
@@ -162,8 +161,7 @@ TEST(EventSimulator, NoiseBeyondTheEventBudgetIsRefusedBeforeDrawing) {
   }
   EventSimulator simulator(32, 32, options);
   simulator.Reset(video.frame(0), 0);
-  EXPECT_THROW(simulator.Advance(video.frame(1), kNanosecondsPerSecond / 10),
-               InvalidArgumentError);
+  EXPECT_THROW(simulator.Advance(video.frame(1), kNanosecondsPerSecond / 10), InvalidArgumentError);
 
   // The budget is an option: 10 Hz over 1024 pixels and 0.2 s is about 2048 events.
   options.noise_rate_hz = 10.0;

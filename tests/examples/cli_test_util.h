@@ -3,6 +3,7 @@
 #ifndef EVFS_TESTS_EXAMPLES_CLI_TEST_UTIL_H_
 #define EVFS_TESTS_EXAMPLES_CLI_TEST_UTIL_H_
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,8 +14,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
@@ -45,8 +44,8 @@ inline CommandResult RunEvfs(const std::string& arguments, const std::string& sh
   // One file per process: ctest runs the tests of one executable side by side.
   const fs::path stderr_file =
       fs::path(EVFS_TEST_TMP_DIR) / ("stderr_" + std::to_string(::getpid()) + ".txt");
-  const std::string command = shell_prefix + std::string(EVFS_BINARY) + " " + arguments + " 2>" +
-                              stderr_file.string();
+  const std::string command =
+      shell_prefix + std::string(EVFS_BINARY) + " " + arguments + " 2>" + stderr_file.string();
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
@@ -78,7 +77,7 @@ inline void ExpectNoStagingLeft(const fs::path& out) {
 // A user error: exit status 2, exactly one short line on stderr holding `expected` (the file
 // and line it names, or the flag), and nothing under `out` or beside it (no staging folder).
 inline void ExpectUserError(const CommandResult& result, const std::string& expected,
-                     const fs::path& out) {
+                            const fs::path& out) {
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
   EXPECT_EQ(result.errors.back(), '\n') << result.errors;

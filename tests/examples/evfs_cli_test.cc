@@ -1,4 +1,5 @@
 // End-to-end tests of the `evfs` tool: what users type, what they read back, exit codes.
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -8,8 +9,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
@@ -63,7 +62,7 @@ TEST(EvfsCli, InfoDescribesTheSharedSnippets) {
 
 TEST(EvfsCli, SimulateWritesAFolderThatInfoReads) {
   EVFS_REQUIRE_SHARED_DATA(data);
-  const std::string out = testing::ScratchDir("simulate") + "/nfs";
+  const std::string out = test::ScratchDir("simulate") + "/nfs";
   const CommandResult simulate =
       RunEvfs("simulate --frames=" + data + "/nfs_basketball_7 --out=" + out);
   ASSERT_EQ(simulate.exit_code, 0) << simulate.output;
@@ -76,7 +75,7 @@ TEST(EvfsCli, SimulateWritesAFolderThatInfoReads) {
 
 TEST(EvfsCli, ConvertRoundTripIsByteIdentical) {
   EVFS_REQUIRE_SHARED_DATA(data);
-  const std::string scratch = testing::ScratchDir("convert");
+  const std::string scratch = test::ScratchDir("convert");
   const std::string source = data + "/shapes_rotation_13_20";
   ASSERT_EQ(RunEvfs("convert --data=" + source + " --out=" + scratch + "/shapes.h5").exit_code, 0);
   ASSERT_EQ(
@@ -86,7 +85,7 @@ TEST(EvfsCli, ConvertRoundTripIsByteIdentical) {
 }
 
 TEST(EvfsCli, ReconstructWritesFramesTimestampsAndSummary) {
-  const std::string scratch = testing::ScratchDir("reconstruct");
+  const std::string scratch = test::ScratchDir("reconstruct");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string out = scratch + "/out";
   const CommandResult run =
@@ -114,7 +113,7 @@ TEST(EvfsCli, ReconstructWritesFramesTimestampsAndSummary) {
 }
 
 TEST(EvfsCli, UserErrorsExitWithStatus2AndLeaveNoOutput) {
-  const std::string scratch = testing::ScratchDir("errors");
+  const std::string scratch = test::ScratchDir("errors");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string out = scratch + "/out";
   const struct {
@@ -159,11 +158,11 @@ std::string TinyEventLines() {
 fs::path WriteTinyFolder(const fs::path& folder) {
   fs::create_directories(folder / "images");
   WriteGreyPng8((folder / "images/a.png").string(),
-                testing::MakeRandomImage(1, kTinyWidth, kTinyHeight, 8));
+                test::MakeRandomImage(1, kTinyWidth, kTinyHeight, 8));
   WriteGreyPng8((folder / "images/b.png").string(),
-                testing::MakeRandomImage(2, kTinyWidth, kTinyHeight, 8));
-  testing::WriteFile((folder / "images.txt").string(), "1.0 images/a.png\n1.1 images/b.png\n");
-  testing::WriteFile((folder / "events.txt").string(), TinyEventLines());
+                test::MakeRandomImage(2, kTinyWidth, kTinyHeight, 8));
+  test::WriteFile((folder / "images.txt").string(), "1.0 images/a.png\n1.1 images/b.png\n");
+  test::WriteFile((folder / "events.txt").string(), TinyEventLines());
   return folder;
 }
 
@@ -178,7 +177,7 @@ std::string ReplaceLine(const std::string& lines, int number, const std::string&
 
 // Every kind of bad data file: exit status 2, one line naming the file (and line), no output.
 TEST(EvfsCli, BadDataFilesAreUserErrors) {
-  const fs::path scratch = testing::ScratchDir("bad_files");
+  const fs::path scratch = test::ScratchDir("bad_files");
   const fs::path out = scratch / "out";
   const std::string events = TinyEventLines();
   const std::string megabyte(1 << 20, '9');
@@ -228,7 +227,7 @@ TEST(EvfsCli, BadDataFilesAreUserErrors) {
     if (c.remove) {
       fs::remove(data / c.file);
     } else {
-      testing::WriteFile((data / c.file).string(), c.content);
+      test::WriteFile((data / c.file).string(), c.content);
     }
     ExpectUserError(RunEvfs("reconstruct --data=" + data.string() + " --mode=" + c.mode +
                             " --out=" + out.string()),
@@ -237,10 +236,10 @@ TEST(EvfsCli, BadDataFilesAreUserErrors) {
 }
 
 TEST(EvfsCli, ImageOfAnotherSizeIsAUserError) {
-  const fs::path scratch = testing::ScratchDir("image_size");
+  const fs::path scratch = test::ScratchDir("image_size");
   const fs::path data = WriteTinyFolder(scratch / "data");
   WriteGreyPng8((data / "images/b.png").string(),
-                testing::MakeRandomImage(3, kTinyWidth + 1, kTinyHeight, 8));
+                test::MakeRandomImage(3, kTinyWidth + 1, kTinyHeight, 8));
   const fs::path out = scratch / "out";
   ExpectUserError(RunEvfs("reconstruct --data=" + data.string() +
                           " --mode=interpolate --first=0 --last=1 --out=" + out.string()),
@@ -248,7 +247,7 @@ TEST(EvfsCli, ImageOfAnotherSizeIsAUserError) {
 }
 
 TEST(EvfsCli, CorruptOrIncompleteHdf5IsAUserError) {
-  const fs::path scratch = testing::ScratchDir("bad_hdf5");
+  const fs::path scratch = test::ScratchDir("bad_hdf5");
   const fs::path good = scratch / "good.h5";
   ConvertRecording(WriteTinyFolder(scratch / "data").string(), good.string());
   const fs::path out = scratch / "out";
@@ -265,7 +264,7 @@ TEST(EvfsCli, CorruptOrIncompleteHdf5IsAUserError) {
   ExpectUserError(reconstruct(truncated), truncated.string() + ":", out);
 
   const fs::path garbage = scratch / "garbage.h5";
-  testing::WriteFile(garbage.string(), std::string(4096, '\x01'));
+  test::WriteFile(garbage.string(), std::string(4096, '\x01'));
   ExpectUserError(reconstruct(garbage), garbage.string() + ": not an HDF5 file", out);
 
   const fs::path no_frames = scratch / "no_frames.h5";
@@ -281,7 +280,7 @@ TEST(EvfsCli, Hdf5FileThatCrashesLibhdf5IsAUserError) {
   const char* asan = std::getenv("ASAN_OPTIONS");
   const std::string asan_options = std::string(asan ? asan : "") + ":handle_segv=0";
   setenv("ASAN_OPTIONS", asan_options.c_str(), 1);
-  const fs::path scratch = testing::ScratchDir("libhdf5_crash");
+  const fs::path scratch = test::ScratchDir("libhdf5_crash");
   const fs::path out = scratch / "out";
   for (const char* name : {"fuzz_libhdf5_segv_cache_read.h5", "fuzz_libhdf5_segv_attribute.h5"}) {
     const std::string h5 = std::string(EVFS_TEST_SOURCE_DIR) + "/data/" + name;
@@ -295,16 +294,15 @@ TEST(EvfsCli, Hdf5FileThatCrashesLibhdf5IsAUserError) {
 }
 
 TEST(EvfsCli, UnwritableOutputIsAUserError) {
-  const fs::path scratch = testing::ScratchDir("unwritable");
+  const fs::path scratch = test::ScratchDir("unwritable");
   const fs::path data = WriteTinyFolder(scratch / "data");
-  testing::WriteFile((scratch / "file").string(), "a file, not a folder");
+  test::WriteFile((scratch / "file").string(), "a file, not a folder");
   const fs::path out = scratch / "file" / "out";
   const CommandResult result = RunEvfs("reconstruct --data=" + data.string() +
                                        " --mode=predict --first=0 --out=" + out.string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
-  EXPECT_NE(result.errors.find(out.string() + ": cannot create the output: "),
-            std::string::npos)
+  EXPECT_NE(result.errors.find(out.string() + ": cannot create the output: "), std::string::npos)
       << result.errors;
   const CommandResult convert =
       RunEvfs("convert --data=" + data.string() + " --out=" + (scratch / "file/x.h5").string());
@@ -314,9 +312,9 @@ TEST(EvfsCli, UnwritableOutputIsAUserError) {
 }
 
 TEST(EvfsCli, ConvertAndSimulateLeaveNothingBehindOnBadInput) {
-  const fs::path scratch = testing::ScratchDir("convert_bad");
+  const fs::path scratch = test::ScratchDir("convert_bad");
   const fs::path data = WriteTinyFolder(scratch / "data");
-  testing::WriteFile((data / "events.txt").string(), ReplaceLine(TinyEventLines(), 9, "1.08 1"));
+  test::WriteFile((data / "events.txt").string(), ReplaceLine(TinyEventLines(), 9, "1.08 1"));
   for (const char* out_name : {"out.h5", "out"}) {
     SCOPED_TRACE(out_name);
     const fs::path out = scratch / out_name;
@@ -331,7 +329,7 @@ TEST(EvfsCli, ConvertAndSimulateLeaveNothingBehindOnBadInput) {
 
 // CRLF, comments, blank lines, -1/1 polarity and last lines without a newline are valid.
 TEST(EvfsCli, OdditiesOfRealFilesAreAccepted) {
-  const fs::path scratch = testing::ScratchDir("oddities");
+  const fs::path scratch = test::ScratchDir("oddities");
   const fs::path data = WriteTinyFolder(scratch / "data");
   std::string odd = "# t x y p\r\n\r\n";
   std::istringstream lines(TinyEventLines());
@@ -340,9 +338,9 @@ TEST(EvfsCli, OdditiesOfRealFilesAreAccepted) {
     odd += line + "\r\n";
   }
   odd.resize(odd.size() - 2);  // no newline after the last event
-  testing::WriteFile((data / "events.txt").string(), odd);
-  testing::WriteFile((data / "images.txt").string(),
-                     "# t path\r\n1.0 images/a.png\r\n\n1.1 images/b.png");
+  test::WriteFile((data / "events.txt").string(), odd);
+  test::WriteFile((data / "images.txt").string(),
+                  "# t path\r\n1.0 images/a.png\r\n\n1.1 images/b.png");
   const fs::path out = scratch / "out";
   const CommandResult run = RunEvfs("reconstruct --data=" + data.string() +
                                     " --mode=interpolate --first=0 --last=1 --out=" + out.string());
@@ -352,9 +350,9 @@ TEST(EvfsCli, OdditiesOfRealFilesAreAccepted) {
 
 // A window without events is answered with the initialisation (here a copy of the frame).
 TEST(EvfsCli, WindowWithoutEventsGivesTheInitialisation) {
-  const fs::path scratch = testing::ScratchDir("no_events");
+  const fs::path scratch = test::ScratchDir("no_events");
   const fs::path data = WriteTinyFolder(scratch / "data");
-  testing::WriteFile((data / "events.txt").string(), "# no events\n");
+  test::WriteFile((data / "events.txt").string(), "# no events\n");
   const fs::path out = scratch / "out";
   const CommandResult run = RunEvfs("reconstruct --data=" + data.string() +
                                     " --mode=predict --first=0 --out=" + out.string());

@@ -2,6 +2,7 @@
 // evfs' own bugs, 4 for a solver that failed), that each is one line saying what is wrong, and
 // that a long command reports progress wherever stderr goes (issue 14, "Failure semantics").
 // Each test works in a scratch folder of its own.
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -10,8 +11,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "tests/examples/cli_test_util.h"
 #include "tests/io/io_test_util.h"
@@ -40,7 +39,7 @@ std::vector<std::string> Lines(const std::string& text) {
 
 // gflags used to print its own text and exit with status 1.
 TEST(EvfsFailure, FlagsThatDoNotParseAreOneLineUserErrors) {
-  const fs::path scratch = testing::ScratchDir("failure_flags");
+  const fs::path scratch = test::ScratchDir("failure_flags");
   const fs::path out = scratch / "out";
   const std::string data = WriteSyntheticFolder(scratch.string());
   const std::string reconstruct =
@@ -86,7 +85,7 @@ TEST(EvfsFailure, HelpAskedForIsASuccess) {
 // solver's: status 4, one line (Ceres' own dump is shown with --minloglevel=0 only), and no
 // output.
 TEST(EvfsFailure, CeresFailureIsASolverFailureNotAUserError) {
-  const fs::path scratch = testing::ScratchDir("failure_solver");
+  const fs::path scratch = test::ScratchDir("failure_solver");
   const fs::path out = scratch / "out";
   const std::string data = WriteSyntheticFolder(scratch.string());
   const CommandResult result = RunEvfs("reconstruct --data=" + data +
@@ -103,7 +102,7 @@ TEST(EvfsFailure, CeresFailureIsASolverFailureNotAUserError) {
 // events.txt or images.txt that exists but is no regular file used to read as "this folder
 // holds frames only" (or, for images.txt, as no frames at all).
 TEST(EvfsFailure, DataFileThatIsNoRegularFileIsNamedAsSuch) {
-  const fs::path scratch = testing::ScratchDir("failure_not_a_file");
+  const fs::path scratch = test::ScratchDir("failure_not_a_file");
   const fs::path out = scratch / "out";
   const fs::path data = WriteSyntheticFolder(scratch.string());
   const std::string reconstruct =
@@ -137,7 +136,7 @@ TEST(EvfsFailure, DataFileThatIsNoRegularFileIsNamedAsSuch) {
 // A folder without images.txt is events alone: `info` describes it (status 0) and says why it
 // lists no frame; reading a frame says the same instead of "has 0 frames (0..-1)".
 TEST(EvfsFailure, MissingFrameListIsNamed) {
-  const fs::path scratch = testing::ScratchDir("failure_no_frames");
+  const fs::path scratch = test::ScratchDir("failure_no_frames");
   const fs::path out = scratch / "out";
   const fs::path data = WriteSyntheticFolder(scratch.string());
   const fs::path images_txt = data / "images.txt";
@@ -172,7 +171,7 @@ const std::regex kProgressLine(
 // stderr is a file here, not a terminal: a command running longer than the interval still
 // says what it does, on a line of its own every interval.
 TEST(EvfsFailure, ProgressIsPrintedOffATerminal) {
-  const fs::path scratch = testing::ScratchDir("failure_progress");
+  const fs::path scratch = test::ScratchDir("failure_progress");
   const std::string data = WriteSyntheticFolder(scratch.string());
   // An interval far below the job's length (a fork, a read, a build and a solve: well over
   // 10 ms), so that several lines come.
@@ -188,7 +187,7 @@ TEST(EvfsFailure, ProgressIsPrintedOffATerminal) {
 }
 
 TEST(EvfsFailure, QuickCommandsPrintNoProgress) {
-  const fs::path scratch = testing::ScratchDir("failure_quick");
+  const fs::path scratch = test::ScratchDir("failure_quick");
   const std::string data = WriteSyntheticFolder(scratch.string());
   const CommandResult result =
       RunEvfs("reconstruct --data=" + data +

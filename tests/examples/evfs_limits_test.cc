@@ -2,6 +2,7 @@
 // unlucky input (a hot pixel, a binning beyond the voxel cap, a file declaring a huge sensor, a
 // flag that overflows arithmetic) makes of `evfs`. Each case is small enough to run in well
 // under a second, yet failed (allocated gigabytes, looped, crashed) before the fix.
+#include <gtest/gtest.h>
 #include <hdf5.h>
 
 #include <algorithm>
@@ -10,8 +11,6 @@
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "io/data_source.h"
 #include "io/hdf5_io.h"
@@ -58,9 +57,8 @@ std::string WriteHotPixelFolder(const std::string& scratch, int count) {
     all.emplace_back(begin_ns + 1 + (end_ns - begin_ns - 2) * i / count, kHotX, kHotY,
                      i % 2 ? 1 : -1);
   }
-  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
-    return std::get<0>(a) < std::get<0>(b);
-  });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
   EventStream hot(events.width(), events.height());
   for (const auto& [t_ns, x, y, polarity] : all) hot.push_back(t_ns, x, y, polarity);
   std::vector<Image> images;
@@ -73,7 +71,7 @@ std::string WriteHotPixelFolder(const std::string& scratch, int count) {
 // Regression (issue 14): one pixel firing a thousand times made `info` and `reconstruct` bin a
 // thousand collision frames of the whole sensor. Its events are left out, and both say so.
 TEST(EvfsLimits, HotPixelIsLeftOutAndReported) {
-  const std::string scratch = testing::ScratchDir("limits_hot_pixel");
+  const std::string scratch = test::ScratchDir("limits_hot_pixel");
   const std::string data = WriteHotPixelFolder(scratch, 1000);
   const CommandResult info = RunLimited("info --data=" + data + " --first=0 --last=4");
   ASSERT_EQ(info.exit_code, 0) << info.output;
@@ -107,7 +105,7 @@ TEST(EvfsLimits, HotPixelIsLeftOutAndReported) {
 // frames were allocated; an explicit --binning beyond it was built whatever its size. It is
 // now a user error in every mode and in `info`, before anything is allocated.
 TEST(EvfsLimits, ExplicitBinningBeyondTheVoxelCapIsAUserError) {
-  const std::string scratch = testing::ScratchDir("limits_voxel_cap");
+  const std::string scratch = test::ScratchDir("limits_voxel_cap");
   const std::string data = WriteHotPixelFolder(scratch, 1000);
   const std::string out = scratch + "/out";
   // 40x32 = 1280 pixels; 1280 x 10 voxels hold 10 latent frames.
@@ -117,14 +115,14 @@ TEST(EvfsLimits, ExplicitBinningBeyondTheVoxelCapIsAUserError) {
         "--mode=deblur --first=2 --exposure_s=0.02"}) {
     SCOPED_TRACE(mode);
     ExpectUserError(RunLimited("reconstruct --data=" + data + " " + mode + " --binning=collision" +
-                        cap + " --out=" + out),
+                               cap + " --out=" + out),
                     "max_latent_voxels = 12800", out);
     ExpectUserError(RunLimited("reconstruct --data=" + data + " " + mode +
-                        " --binning=stacked --stacked_frames=10" + cap + " --out=" + out),
+                               " --binning=stacked --stacked_frames=10" + cap + " --out=" + out),
                     "max_latent_voxels = 12800", out);
     // Auto binning takes what fits: 9 stacked frames, 10 latent frames.
     const CommandResult fits = RunLimited("reconstruct --data=" + data + " " + mode + cap +
-                                   " --max_iterations=1 --out=" + out);
+                                          " --max_iterations=1 --out=" + out);
     ASSERT_EQ(fits.exit_code, 0) << fits.output;
     EXPECT_NE(fits.output.find("9 event frames, 10 latent frames"), std::string::npos)
         << fits.output;
@@ -140,9 +138,10 @@ TEST(EvfsLimits, ExplicitBinningBeyondTheVoxelCapIsAUserError) {
             std::string::npos)
       << info.output;
   // A cap below two latent frames of the sensor: nothing fits.
-  ExpectUserError(RunLimited("reconstruct --data=" + data +
-                      " --mode=predict --first=0 --last=4 --max_latent_voxels=2000 --out=" + out),
-                  "needs at least 2 latent frames", out);
+  ExpectUserError(
+      RunLimited("reconstruct --data=" + data +
+                 " --mode=predict --first=0 --last=4 --max_latent_voxels=2000 --out=" + out),
+      "needs at least 2 latent frames", out);
 }
 
 // Rewrites the root attribute sensor_resolution of an HDF5 file as [height, width].
@@ -153,8 +152,8 @@ void DeclareSensorResolution(const std::string& path, int64_t height, int64_t wi
   const hsize_t two = 2;
   const int64_t resolution[2] = {height, width};
   const hid_t space = H5Screate_simple(1, &two, nullptr);
-  const hid_t attribute = H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space,
-                                     H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t attribute =
+      H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
   H5Awrite(attribute, H5T_NATIVE_INT64, resolution);
   H5Aclose(attribute);
   H5Sclose(space);
@@ -165,54 +164,57 @@ void DeclareSensorResolution(const std::string& path, int64_t height, int64_t wi
 // for 4 G pixels (bad_alloc, or the machine's memory). It is a one-line user error now, and so
 // is a declared size the frames do not have.
 TEST(EvfsLimits, HugeDeclaredSensorIsAUserError) {
-  const std::string scratch = testing::ScratchDir("limits_sensor_size");
+  const std::string scratch = test::ScratchDir("limits_sensor_size");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string h5 = scratch + "/data.h5";
   ASSERT_EQ(RunLimited("convert --data=" + data + " --out=" + h5).exit_code, 0);
   DeclareSensorResolution(h5, 65535, 65535);
   for (const std::string window : {"", " --first=0 --last=1"}) {
-    ExpectUserError(RunLimited("info --data=" + h5 + window), "65535x65535 sensor", scratch + "/never");
+    ExpectUserError(RunLimited("info --data=" + h5 + window), "65535x65535 sensor",
+                    scratch + "/never");
   }
-  ExpectUserError(RunLimited("reconstruct --data=" + h5 + " --mode=predict --first=0 --out=" + scratch +
-                      "/out"),
+  ExpectUserError(RunLimited("reconstruct --data=" + h5 +
+                             " --mode=predict --first=0 --out=" + scratch + "/out"),
                   "65535x65535 sensor", scratch + "/out");
   DeclareSensorResolution(h5, 4096, 4096);
-  ExpectUserError(RunLimited("info --data=" + h5 + " --first=0 --last=1"), "the sensor is 4096x4096",
-                  scratch + "/never");
+  ExpectUserError(RunLimited("info --data=" + h5 + " --first=0 --last=1"),
+                  "the sensor is 4096x4096", scratch + "/never");
 }
 
 // Regression (issue 14): --fps below ~1e-10 made the resampling's int64 arithmetic wrap, and it
 // looped forever, allocating. A rate below one frame per window gives the first frame alone.
 TEST(EvfsLimits, TinyFpsGivesOneFrame) {
-  const std::string scratch = testing::ScratchDir("limits_fps");
+  const std::string scratch = test::ScratchDir("limits_fps");
   const std::string data = WriteSyntheticFolder(scratch);
   for (const std::string fps : {"1e-12", "1e-300"}) {
     SCOPED_TRACE(fps);
     const std::string out = scratch + "/out_" + fps;
-    const CommandResult run = RunLimited("reconstruct --data=" + data +
-                                  " --mode=predict --first=0 --last=1 --solver=copy --fps=" +
-                                  fps + " --out=" + out);
+    const CommandResult run = RunLimited(
+        "reconstruct --data=" + data +
+        " --mode=predict --first=0 --last=1 --solver=copy --fps=" + fps + " --out=" + out);
     ASSERT_NE(run.exit_code, kTimedOut) << "looped";
     ASSERT_EQ(run.exit_code, 0) << run.output;
     const std::string timestamps = ReadFile(out + "/timestamps.txt");
     EXPECT_EQ(std::count(timestamps.begin(), timestamps.end(), '\n'), 1) << timestamps;
   }
-  ExpectUserError(RunLimited("reconstruct --data=" + data +
-                      " --mode=predict --first=0 --last=1 --fps=1e300 --out=" + scratch + "/out"),
-                  "--fps", scratch + "/out");
+  ExpectUserError(
+      RunLimited("reconstruct --data=" + data +
+                 " --mode=predict --first=0 --last=1 --fps=1e300 --out=" + scratch + "/out"),
+      "--fps", scratch + "/out");
 }
 
 // Regression (issue 14): --activity_radius_px of 2^31 - 239 or more overflowed int in the
 // dilation of the activity mask (SIGSEGV). Any radius beyond the sensor solves every pixel.
 TEST(EvfsLimits, HugeActivityRadiusSolvesEveryPixel) {
-  const std::string scratch = testing::ScratchDir("limits_radius");
+  const std::string scratch = test::ScratchDir("limits_radius");
   const std::string data = WriteSyntheticFolder(scratch);
   for (const std::string radius : {"2147483409", "2147483647"}) {
     SCOPED_TRACE(radius);
     const std::string out = scratch + "/out_" + radius;
-    const CommandResult run =
-        RunLimited("reconstruct --data=" + data + " --mode=predict --first=0 --last=1 --max_iterations=2"
-            " --activity_radius_px=" + radius + " --out=" + out);
+    const CommandResult run = RunLimited("reconstruct --data=" + data +
+                                         " --mode=predict --first=0 --last=1 --max_iterations=2"
+                                         " --activity_radius_px=" +
+                                         radius + " --out=" + out);
     ASSERT_EQ(run.exit_code, 0) << run.output;
     const std::string summary = ReadFile(out + "/summary.json");
     EXPECT_NE(summary.find("\"active\": 1280,"), std::string::npos) << summary;
@@ -223,7 +225,7 @@ TEST(EvfsLimits, HugeActivityRadiusSolvesEveryPixel) {
 // Regression (issue 14): simulate --noise_rate_hz=1e12 drew noise events until memory ran out
 // (bad_alloc, exit 1). The expected count is known before drawing: a one-line user error.
 TEST(EvfsLimits, NoiseBeyondTheEventBudgetIsAUserError) {
-  const std::string scratch = testing::ScratchDir("limits_noise");
+  const std::string scratch = test::ScratchDir("limits_noise");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string out = scratch + "/simulated";
   ExpectUserError(RunLimited("simulate --frames=" + data + " --noise_rate_hz=1e12 --out=" + out),

@@ -2,6 +2,7 @@
 // that once deleted user files (issue 14). Each test works in a sandbox folder of its own, with
 // stand-ins for the home folder, the current folder and the input; no test names a real system
 // path as --out.
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,8 +12,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "io/output_target.h"
 #include "tests/examples/cli_test_util.h"
@@ -33,22 +32,22 @@ using test::WriteSyntheticFolder;
 // A sandbox: a synthetic recording in data/, stand-ins for home and the current folder, and a
 // user's folder of precious files.
 struct Sandbox {
-  explicit Sandbox(const std::string& name) : root(testing::ScratchDir("output_" + name)) {
+  explicit Sandbox(const std::string& name) : root(test::ScratchDir("output_" + name)) {
     data = WriteSyntheticFolder(root.string());
-    for (const char* folder : {"home", "cwd/deeper", "thesis"}) fs::create_directories(root / folder);
-    testing::WriteFile((root / "thesis/chapter1.tex").string(), "precious");
+    for (const char* folder : {"home", "cwd/deeper", "thesis"})
+      fs::create_directories(root / folder);
+    test::WriteFile((root / "thesis/chapter1.tex").string(), "precious");
   }
 
   // Runs evfs in the stand-in current folder with the stand-in home folder.
   CommandResult Run(const std::string& arguments) const {
-    return RunEvfs(arguments,
-                   "cd " + (root / "cwd/deeper").string() + " && HOME=" + (root / "home").string() +
-                       " ");
+    return RunEvfs(arguments, "cd " + (root / "cwd/deeper").string() +
+                                  " && HOME=" + (root / "home").string() + " ");
   }
 
   std::string Reconstruct(const fs::path& out) const {
-    return "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=1 --out=" +
-           out.string();
+    return "reconstruct --data=" + data +
+           " --mode=interpolate --first=0 --last=1 --out=" + out.string();
   }
 
   // Every writing command, with --out=`out`.
@@ -139,8 +138,8 @@ TEST(EvfsOutput, AnExistingFileIsNeverReplaced) {
   const Sandbox sandbox("file");
   const fs::path notes = sandbox.root / "notes.txt";
   const fs::path recording = sandbox.root / "recording.h5";
-  testing::WriteFile(notes.string(), "mine");
-  testing::WriteFile(recording.string(), "not even HDF5, but mine");
+  test::WriteFile(notes.string(), "mine");
+  test::WriteFile(recording.string(), "not even HDF5, but mine");
   for (const std::string& command : sandbox.AllCommands(notes)) {
     SCOPED_TRACE(command);
     ExpectRefused(sandbox.Run(command + " --overwrite"), "refusing --out=");
@@ -170,7 +169,8 @@ TEST(EvfsOutput, NewFoldersWithTrailingSlashesOrMissingParentsAreMade) {
     EXPECT_EQ(result.exit_code, 0) << out << ": " << result.output;
     EXPECT_TRUE(fs::exists(sandbox.root / out)) << out;
   }
-  const CommandResult info = sandbox.Run("info --data=" + (sandbox.root / "a/b/converted.h5").string());
+  const CommandResult info =
+      sandbox.Run("info --data=" + (sandbox.root / "a/b/converted.h5").string());
   EXPECT_EQ(info.exit_code, 0) << info.output;
 }
 
@@ -180,7 +180,7 @@ TEST(EvfsOutput, AnEarlierOutputIsReplacedWholeAndOnlyWithOverwrite) {
   const std::string simulate = "simulate --frames=" + sandbox.data + " --out=" + sim.string();
   ASSERT_EQ(sandbox.Run(simulate).exit_code, 0);
   // A file of an older run (exposures.txt once survived and changed how the data was read).
-  testing::WriteFile((sim / "exposures.txt").string(), "images/frame_0.png 0 0.001\n");
+  test::WriteFile((sim / "exposures.txt").string(), "images/frame_0.png 0 0.001\n");
   ExpectRefused(sandbox.Run(simulate), "pass --overwrite to replace it");
   EXPECT_TRUE(fs::exists(sim / "exposures.txt"));
   ASSERT_EQ(sandbox.Run(simulate + " --overwrite").exit_code, 0);
@@ -204,15 +204,15 @@ TEST(EvfsOutput, AnEarlierOutputIsReplacedWholeAndOnlyWithOverwrite) {
 
 TEST(EvfsOutput, ABadOutFailsBeforeAnyInputIsRead) {
   const Sandbox sandbox("early");
-  testing::WriteFile((sandbox.root / "file").string(), "a file");
+  test::WriteFile((sandbox.root / "file").string(), "a file");
   const std::string missing = (sandbox.root / "no_such_recording").string();
   const std::string bad_out = (sandbox.root / "file/out").string();
   for (const std::string& command :
        {"reconstruct --data=" + missing + " --mode=predict --first=0 --out=" + bad_out,
         "simulate --frames=" + missing + " --out=" + bad_out,
         "convert --data=" + missing + " --out=" + bad_out,
-        "reconstruct --data=" + missing + " --mode=predict --first=0 --out=" +
-            (sandbox.root / "thesis").string()}) {
+        "reconstruct --data=" + missing +
+            " --mode=predict --first=0 --out=" + (sandbox.root / "thesis").string()}) {
     SCOPED_TRACE(command);
     const CommandResult result = sandbox.Run(command);
     EXPECT_EQ(result.exit_code, 2) << result.output;
@@ -263,9 +263,9 @@ void ExpectSignalLeavesTheEarlierOutput(int signal_number, bool hdf5) {
     ASSERT_EQ(RunEvfs("convert --data=" + sandbox.data + " --out=" + data).exit_code, 0);
   }
   const fs::path out = sandbox.root / "out";
-  const std::vector<std::string> arguments = {"reconstruct", "--data=" + data,
-                                              "--mode=interpolate", "--first=0", "--last=1",
-                                              "--out=" + out.string()};
+  const std::vector<std::string> arguments = {"reconstruct",        "--data=" + data,
+                                              "--mode=interpolate", "--first=0",
+                                              "--last=1",           "--out=" + out.string()};
   const CommandResult earlier = sandbox.Run(sandbox.Reconstruct(out));
   ASSERT_EQ(earlier.exit_code, 0) << earlier.output;
   const std::string earlier_summary = ReadFile((out / "summary.json").string());

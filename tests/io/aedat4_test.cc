@@ -29,8 +29,8 @@
 namespace evfs {
 namespace {
 
-using testing::MakeRandomEvents;
-using testing::ScratchDir;
+using test::MakeRandomEvents;
+using test::ScratchDir;
 
 constexpr char kSampleFolder[] = "aedat4_dvxplorer_sample";
 constexpr char kSampleFile[] = "sample.aedat4";

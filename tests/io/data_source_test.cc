@@ -29,8 +29,8 @@ void ExpectSameRecording(const DataSource& expected, const DataSource& actual) {
 }
 
 TEST(DataSourceTest, OpenDispatchesOnFolderOrExtension) {
-  const std::string dir = testing::ScratchDir("open_dispatch");
-  const EventStream events = testing::MakeRandomEvents(1, 100, kWidth, kHeight, 0, 1000);
+  const std::string dir = test::ScratchDir("open_dispatch");
+  const EventStream events = test::MakeRandomEvents(1, 100, kWidth, kHeight, 0, 1000);
   WriteDataFolder(dir + "/folder", events, {}, {});
   WriteHdf5(dir + "/file.H5", events, {}, {});
   EXPECT_NE(dynamic_cast<TextFolderDataSource*>(DataSource::Open(dir + "/folder").get()), nullptr);
@@ -38,18 +38,18 @@ TEST(DataSourceTest, OpenDispatchesOnFolderOrExtension) {
   EXPECT_TRUE(IsHdf5Path("a/b.hdf5"));
   EXPECT_FALSE(IsHdf5Path("a/b.h5/c"));
 
-  testing::ExpectInputError([&] { DataSource::Open(dir + "/nothing"); },
-                            InputError::Kind::kMissingFile, dir + "/nothing", 0);
-  testing::WriteFile(dir + "/events.txt", "0.1 1 1 1\n");
-  testing::ExpectInputError([&] { DataSource::Open(dir + "/events.txt"); },
-                            InputError::Kind::kMalformed, dir + "/events.txt", 0);
+  test::ExpectInputError([&] { DataSource::Open(dir + "/nothing"); },
+                         InputError::Kind::kMissingFile, dir + "/nothing", 0);
+  test::WriteFile(dir + "/events.txt", "0.1 1 1 1\n");
+  test::ExpectInputError([&] { DataSource::Open(dir + "/events.txt"); },
+                         InputError::Kind::kMalformed, dir + "/events.txt", 0);
 }
 
 // text -> HDF5 -> text keeps events to the nanosecond, frames with their bit depth, timestamps,
 // exposures and paths; the events.txt comes back byte-identical.
 TEST(DataSourceTest, SyntheticConversionRoundTripIsLossless) {
-  const std::string dir = testing::ScratchDir("convert_synthetic");
-  const EventStream events = testing::MakeRandomEvents(2, 30000, kWidth, kHeight, 713584001, 3000);
+  const std::string dir = test::ScratchDir("convert_synthetic");
+  const EventStream events = test::MakeRandomEvents(2, 30000, kWidth, kHeight, 713584001, 3000);
   std::vector<FrameInfo> frames(3);
   for (int i = 0; i < 3; ++i) {
     frames[i].t_ns = 700000000 + 20000001 * i;
@@ -58,9 +58,9 @@ TEST(DataSourceTest, SyntheticConversionRoundTripIsLossless) {
   frames[2].has_exposure = true;
   frames[2].exposure_begin_ns = 735000000;
   frames[2].exposure_end_ns = 745000002;
-  const std::vector<Image> images = {testing::MakeRandomImage(3, kWidth, kHeight, 8),
-                                     testing::MakeRandomImage(4, kWidth, kHeight, 16),
-                                     testing::MakeRandomImage(5, kWidth, kHeight, 8)};
+  const std::vector<Image> images = {test::MakeRandomImage(3, kWidth, kHeight, 8),
+                                     test::MakeRandomImage(4, kWidth, kHeight, 16),
+                                     test::MakeRandomImage(5, kWidth, kHeight, 8)};
   WriteDataFolder(dir + "/original", events, frames, images);
   ConvertRecording(dir + "/original", dir + "/converted.h5");
   ConvertRecording(dir + "/converted.h5", dir + "/back");
@@ -68,10 +68,8 @@ TEST(DataSourceTest, SyntheticConversionRoundTripIsLossless) {
   const auto original = DataSource::Open(dir + "/original");
   ExpectSameRecording(*original, *DataSource::Open(dir + "/converted.h5"));
   ExpectSameRecording(*original, *DataSource::Open(dir + "/back"));
-  EXPECT_EQ(testing::ReadFile(dir + "/back/events.txt"),
-            testing::ReadFile(dir + "/original/events.txt"));
-  EXPECT_EQ(testing::ReadFile(dir + "/back/images.txt"),
-            testing::ReadFile(dir + "/original/images.txt"));
+  EXPECT_EQ(test::ReadFile(dir + "/back/events.txt"), test::ReadFile(dir + "/original/events.txt"));
+  EXPECT_EQ(test::ReadFile(dir + "/back/images.txt"), test::ReadFile(dir + "/original/images.txt"));
 }
 
 struct SharedSnippet {
@@ -119,23 +117,22 @@ TEST(DataSourceTest, SharedDataConversionRoundTripIsByteIdentical) {
   for (const SharedSnippet& snippet : kSnippets) {
     SCOPED_TRACE(snippet.folder);
     const std::string original = data_dir + "/" + snippet.folder;
-    const std::string dir = testing::ScratchDir(std::string("convert_shared_") + snippet.folder);
+    const std::string dir = test::ScratchDir(std::string("convert_shared_") + snippet.folder);
     ConvertRecording(original, dir + "/converted.h5");
     ConvertRecording(dir + "/converted.h5", dir + "/back");
     const auto source = DataSource::Open(original);
     ExpectSameRecording(*source, *DataSource::Open(dir + "/converted.h5"));
     ExpectSameRecording(*source, *DataSource::Open(dir + "/back"));
-    EXPECT_TRUE(testing::ReadFile(dir + "/back/events.txt") ==
-                testing::ReadFile(original + "/events.txt"));
-    EXPECT_EQ(testing::ReadFile(dir + "/back/images.txt"),
-              testing::ReadFile(original + "/images.txt"));
+    EXPECT_TRUE(test::ReadFile(dir + "/back/events.txt") ==
+                test::ReadFile(original + "/events.txt"));
+    EXPECT_EQ(test::ReadFile(dir + "/back/images.txt"), test::ReadFile(original + "/images.txt"));
   }
 }
 
 TEST(DataSourceTest, SharedDataWindowsMatchInBothFormats) {
   EVFS_REQUIRE_SHARED_DATA(data_dir);
   const std::string original = data_dir + "/shapes_rotation_13_20";
-  const std::string h5 = testing::ScratchDir("windows_shared") + "/shapes.h5";
+  const std::string h5 = test::ScratchDir("windows_shared") + "/shapes.h5";
   ConvertRecording(original, h5);
   const auto text = DataSource::Open(original);
   const auto hdf5 = DataSource::Open(h5);

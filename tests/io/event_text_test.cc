@@ -19,8 +19,8 @@ constexpr int kHeight = 180;
 
 // Writes `content` as events.txt in a fresh scratch folder and returns its path.
 std::string EventsFile(const std::string& test_name, const std::string& content) {
-  const std::string path = testing::ScratchDir(test_name) + "/events.txt";
-  testing::WriteFile(path, content);
+  const std::string path = test::ScratchDir(test_name) + "/events.txt";
+  test::WriteFile(path, content);
   return path;
 }
 
@@ -91,12 +91,12 @@ TEST_P(MalformedLineTest, ThrowsNamingFileAndLine) {
   // Line 3 is the bad one (after a comment and a valid event); a valid line follows.
   const std::string content = std::string("# header\n0.5 1 2 1\n") + c.bad_line + "\n0.9 1 2 1\n";
   const std::string path = EventsFile(std::string("malformed_") + c.name, content);
-  testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); }, c.kind, path, 3);
-  const InputError error = testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); });
+  test::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); }, c.kind, path, 3);
+  const InputError error = test::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); });
   EXPECT_NE(std::string(error.what()).find(c.message_part), std::string::npos) << error.what();
   // The summary parses the same lines and must fail the same way.
-  testing::ExpectInputError([&] { EventTextReader(path, kWidth, kHeight).Summarize(); }, c.kind,
-                            path, 3);
+  test::ExpectInputError([&] { EventTextReader(path, kWidth, kHeight).Summarize(); }, c.kind, path,
+                         3);
 }
 
 std::string CaseName(const ::testing::TestParamInfo<MalformedCase>& info) {
@@ -158,19 +158,19 @@ INSTANTIATE_TEST_SUITE_P(Order, MalformedLineTest,
 
 TEST(EventTextReaderTest, ErrorOnTheLastLineWithoutNewlineNamesItsLine) {
   const std::string path = EventsFile("last_line_error", "0.5 1 2 1\n0.6 1 2\n0.7 1 2 5");
-  testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
-                            InputError::Kind::kMalformed, path, 2);
+  test::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
+                         InputError::Kind::kMalformed, path, 2);
   const std::string tail_path = EventsFile("tail_error", "0.5 1 2 1\n0.6 1 2 1\n0.7 1 2 5");
-  testing::ExpectInputError([&] { ReadEventsText(tail_path, kWidth, kHeight); },
-                            InputError::Kind::kOutOfRange, tail_path, 3);
+  test::ExpectInputError([&] { ReadEventsText(tail_path, kWidth, kHeight); },
+                         InputError::Kind::kOutOfRange, tail_path, 3);
 }
 
 TEST(EventTextReaderTest, TruncatedLastLineIsMalformed) {
   // A file cut short while it was written: the last line lacks fields and its newline.
   const std::string path = EventsFile("truncated", "0.5 1 2 1\n0.6 1 2 1\n0.7 1");
-  testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
-                            InputError::Kind::kMalformed, path, 3);
-  const InputError error = testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); });
+  test::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
+                         InputError::Kind::kMalformed, path, 3);
+  const InputError error = test::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); });
   EXPECT_NE(std::string(error.what()).find("found 2"), std::string::npos) << error.what();
 }
 
@@ -190,9 +190,9 @@ TEST(EventTextReaderTest, MegabyteLinesGiveShortMessages) {
     SCOPED_TRACE(c.name);
     const std::string path =
         EventsFile(std::string("megabyte_") + c.name, "0.5 1 2 1\n" + c.bad_line + "\n");
-    testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); }, c.kind, path, 2);
-    testing::ExpectShortPrintableMessage(
-        testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); }));
+    test::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); }, c.kind, path, 2);
+    test::ExpectShortPrintableMessage(
+        test::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); }));
   }
 }
 
@@ -209,10 +209,10 @@ TEST(EventTextReaderTest, BinaryGarbageIsMalformedWithAPrintableMessage) {
   for (const std::string& bad_line :
        {garbage, "0.6 1 2 " + garbage, std::string("0.6\x01 1 2 1")}) {
     const std::string path = EventsFile("binary", "0.5 1 2 1\n" + bad_line + "\n0.7 1 2 1\n");
-    testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
-                              InputError::Kind::kMalformed, path, 2);
-    testing::ExpectShortPrintableMessage(
-        testing::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); }));
+    test::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
+                           InputError::Kind::kMalformed, path, 2);
+    test::ExpectShortPrintableMessage(
+        test::CatchInputError([&] { ReadEventsText(path, kWidth, kHeight); }));
   }
 }
 
@@ -225,7 +225,7 @@ TEST(EventTextReaderTest, BytesInMemoryParseLikeTheFile) {
   EXPECT_EQ(from_memory.ReadAll(), ReadEventsText(path, kWidth, kHeight));
   EXPECT_EQ(from_memory.Read(600000000, 700000000).size(), 1u);
   const std::string bad = "0.5 1 2 1\n0.6 1 2\n";
-  testing::ExpectInputError(
+  test::ExpectInputError(
       [&] {
         EventTextReader(MappedFile::FromMemory("memory/bad.txt", bad.data(), bad.size())).ReadAll();
       },
@@ -235,14 +235,13 @@ TEST(EventTextReaderTest, BytesInMemoryParseLikeTheFile) {
 TEST(EventTextReaderTest, ErrorDeepInALargeFileNamesItsLine) {
   // Far from the start, so that the fast path and the line counting on error are both used.
   constexpr int kBadLine = 150001;
-  EventStream events =
-      testing::MakeRandomEvents(3, kBadLine - 1, kWidth, kHeight, 1000000000, 20000);
-  const std::string dir = testing::ScratchDir("deep_error");
+  EventStream events = test::MakeRandomEvents(3, kBadLine - 1, kWidth, kHeight, 1000000000, 20000);
+  const std::string dir = test::ScratchDir("deep_error");
   WriteEventsText(dir + "/events.txt", events);
   const std::string path = dir + "/events.txt";
-  testing::WriteFile(path, testing::ReadFile(path) + "9.5 1 2 1 1\n");
-  testing::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
-                            InputError::Kind::kMalformed, path, kBadLine);
+  test::WriteFile(path, test::ReadFile(path) + "9.5 1 2 1 1\n");
+  test::ExpectInputError([&] { ReadEventsText(path, kWidth, kHeight); },
+                         InputError::Kind::kMalformed, path, kBadLine);
 }
 
 // A file of 200k events; windows anywhere (empty, at the ends, inside, beyond) must equal
@@ -251,14 +250,14 @@ TEST(EventTextReaderTest, WindowedReadEqualsSlicingTheFullRead) {
   constexpr int kCount = 200000;
   constexpr uint32_t kSeed = 5;
   const EventStream events =
-      testing::MakeRandomEvents(kSeed, kCount, kWidth, kHeight, 1000000000, 30000);
-  const std::string dir = testing::ScratchDir("windowed");
+      test::MakeRandomEvents(kSeed, kCount, kWidth, kHeight, 1000000000, 30000);
+  const std::string dir = test::ScratchDir("windowed");
   const std::string path = dir + "/events.txt";
   // A comment in the middle of the file must not confuse the binary search.
   WriteEventsText(path, events.SliceIndex(0, kCount / 2));
   WriteEventsText(dir + "/second_half.txt", events.SliceIndex(kCount / 2, kCount));
-  testing::WriteFile(path, testing::ReadFile(path) + "# half way\n\n" +
-                               testing::ReadFile(dir + "/second_half.txt"));
+  test::WriteFile(
+      path, test::ReadFile(path) + "# half way\n\n" + test::ReadFile(dir + "/second_half.txt"));
 
   const EventTextReader reader(path, kWidth, kHeight);
   const EventStream all = reader.ReadAll();
@@ -284,8 +283,8 @@ TEST(EventTextReaderTest, WindowedReadEqualsSlicingTheFullRead) {
 }
 
 TEST(EventTextReaderTest, WindowedReadKeepsWholeRunsOfEqualTimestamps) {
-  const std::string path = testing::ScratchDir("windowed_runs") + "/events.txt";
-  testing::ExpectWindowsKeepWholeRuns(
+  const std::string path = test::ScratchDir("windowed_runs") + "/events.txt";
+  test::ExpectWindowsKeepWholeRuns(
       kWidth, kHeight, [&](const EventStream& events) { WriteEventsText(path, events); },
       [&](int64_t t_begin_ns, int64_t t_end_ns) {
         return EventTextReader(path, kWidth, kHeight).Read(t_begin_ns, t_end_ns);
@@ -294,26 +293,24 @@ TEST(EventTextReaderTest, WindowedReadKeepsWholeRunsOfEqualTimestamps) {
 
 TEST(EventTextReaderTest, WindowedReadStillValidatesTheLinesItParses) {
   constexpr int kCount = 50000;
-  const EventStream events =
-      testing::MakeRandomEvents(9, kCount, kWidth, kHeight, 1000000000, 30000);
-  const std::string dir = testing::ScratchDir("windowed_validation");
+  const EventStream events = test::MakeRandomEvents(9, kCount, kWidth, kHeight, 1000000000, 30000);
+  const std::string dir = test::ScratchDir("windowed_validation");
   const std::string path = dir + "/events.txt";
   WriteEventsText(dir + "/a.txt", events.SliceIndex(0, kCount / 2));
   WriteEventsText(dir + "/b.txt", events.SliceIndex(kCount / 2, kCount));
-  testing::WriteFile(
-      path, testing::ReadFile(dir + "/a.txt") + "oops\n" + testing::ReadFile(dir + "/b.txt"));
+  test::WriteFile(path, test::ReadFile(dir + "/a.txt") + "oops\n" + test::ReadFile(dir + "/b.txt"));
   const EventTextReader reader(path, kWidth, kHeight);
   // A window across the bad line fails, naming it; a window far from it does not.
   const int64_t t_bad = events.t_ns(kCount / 2);
-  testing::ExpectInputError([&] { reader.Read(t_bad - 100000, t_bad + 100000); },
-                            InputError::Kind::kMalformed, path, kCount / 2 + 1);
+  test::ExpectInputError([&] { reader.Read(t_bad - 100000, t_bad + 100000); },
+                         InputError::Kind::kMalformed, path, kCount / 2 + 1);
   EXPECT_EQ(reader.Read(events.t_ns(100), events.t_ns(200)),
             events.Slice(events.t_ns(100), events.t_ns(200)));
 }
 
 TEST(EventTextReaderTest, SummaryCountsEverything) {
-  const EventStream events = testing::MakeRandomEvents(21, 1000, kWidth, kHeight, 5000, 1000);
-  const std::string path = testing::ScratchDir("summary") + "/events.txt";
+  const EventStream events = test::MakeRandomEvents(21, 1000, kWidth, kHeight, 5000, 1000);
+  const std::string path = test::ScratchDir("summary") + "/events.txt";
   WriteEventsText(path, events);
   const EventSummary summary = EventTextReader(path, kWidth, kHeight).Summarize();
   EXPECT_EQ(summary.count, 1000);
@@ -323,16 +320,16 @@ TEST(EventTextReaderTest, SummaryCountsEverything) {
 }
 
 TEST(WriteEventsTextTest, UsesTheFewestDigitsAndZeroOnePolarity) {
-  const std::string path = testing::ScratchDir("write_digits") + "/events.txt";
+  const std::string path = test::ScratchDir("write_digits") + "/events.txt";
   WriteEventsText(path, Expected({{2713576000, 1, 2, 1}, {2713580500, 3, 4, -1}}));
-  EXPECT_EQ(testing::ReadFile(path), "2.7135760 1 2 1\n2.7135805 3 4 0\n");
+  EXPECT_EQ(test::ReadFile(path), "2.7135760 1 2 1\n2.7135805 3 4 0\n");
   WriteEventsText(path, EventStream(kWidth, kHeight));
-  EXPECT_EQ(testing::ReadFile(path), "");
+  EXPECT_EQ(test::ReadFile(path), "");
 }
 
 TEST(WriteEventsTextTest, RoundTripsRandomEvents) {
-  const EventStream events = testing::MakeRandomEvents(4, 20000, kWidth, kHeight, 123456789, 50000);
-  const std::string path = testing::ScratchDir("write_roundtrip") + "/events.txt";
+  const EventStream events = test::MakeRandomEvents(4, 20000, kWidth, kHeight, 123456789, 50000);
+  const std::string path = test::ScratchDir("write_roundtrip") + "/events.txt";
   WriteEventsText(path, events);
   EXPECT_EQ(ReadEventsText(path, kWidth, kHeight), events);
 }
@@ -340,24 +337,24 @@ TEST(WriteEventsTextTest, RoundTripsRandomEvents) {
 // The same events written with tabs, -1 polarity and CRLF take the general parser instead of
 // the fast path for canonical lines; both must agree.
 TEST(EventTextReaderTest, GeneralAndFastParsersAgree) {
-  const EventStream events = testing::MakeRandomEvents(6, 5000, kWidth, kHeight, 987654321, 5000);
-  const std::string dir = testing::ScratchDir("general_parser");
+  const EventStream events = test::MakeRandomEvents(6, 5000, kWidth, kHeight, 987654321, 5000);
+  const std::string dir = test::ScratchDir("general_parser");
   std::string odd;
   for (size_t i = 0; i < events.size(); ++i) {
     odd += FormatDecimalSeconds(events.t_ns(i), kMaxFractionDigits) + "\t" +
            std::to_string(events.x(i)) + "\t" + std::to_string(events.y(i)) + "\t" +
            (events.polarity(i) > 0 ? "1" : "-1") + "\r\n";
   }
-  testing::WriteFile(dir + "/odd.txt", odd);
+  test::WriteFile(dir + "/odd.txt", odd);
   WriteEventsText(dir + "/canonical.txt", events);
   EXPECT_EQ(ReadEventsText(dir + "/odd.txt", kWidth, kHeight), events);
   EXPECT_EQ(ReadEventsText(dir + "/canonical.txt", kWidth, kHeight), events);
 }
 
 TEST(WriteEventsTextTest, UnwritablePathIsAnInputError) {
-  const std::string path = testing::ScratchDir("write_unwritable") + "/missing/events.txt";
-  testing::ExpectInputError([&] { WriteEventsText(path, EventStream()); },
-                            InputError::Kind::kUnwritable, path, 0);
+  const std::string path = test::ScratchDir("write_unwritable") + "/missing/events.txt";
+  test::ExpectInputError([&] { WriteEventsText(path, EventStream()); },
+                         InputError::Kind::kUnwritable, path, 0);
 }
 
 // The shared DAVIS snippets: read, windowed reads, and a byte-identical rewrite.
@@ -385,9 +382,9 @@ TEST(EventTextReaderTest, SharedDataParsesWindowsAndRewritesByteIdentically) {
       ASSERT_EQ(reader.Read(begin, end), all.Slice(begin, end)) << "window " << k;
     }
     const std::string rewritten =
-        testing::ScratchDir(std::string("rewrite_") + snippet.folder) + "/e.txt";
+        test::ScratchDir(std::string("rewrite_") + snippet.folder) + "/e.txt";
     WriteEventsText(rewritten, all);
-    EXPECT_TRUE(testing::ReadFile(rewritten) == testing::ReadFile(path))
+    EXPECT_TRUE(test::ReadFile(rewritten) == test::ReadFile(path))
         << "rewrite differs from " << path;
   }
 }

@@ -14,8 +14,8 @@ namespace {
 
 std::string TextFile(const std::string& test_name, const std::string& file_name,
                      const std::string& content) {
-  const std::string path = testing::ScratchDir(test_name) + "/" + file_name;
-  testing::WriteFile(path, content);
+  const std::string path = test::ScratchDir(test_name) + "/" + file_name;
+  test::WriteFile(path, content);
   return path;
 }
 
@@ -52,7 +52,7 @@ void ExpectBadLineErrors(const std::string& file_name, const std::string& first_
     SCOPED_TRACE(c.name);
     const std::string path =
         TextFile(file_name + "_" + c.name, file_name, first_line + "\n" + c.bad_line + "\n");
-    testing::ExpectInputError([&] { read(path); }, kind, path, 2);
+    test::ExpectInputError([&] { read(path); }, kind, path, 2);
   }
 }
 
@@ -70,15 +70,15 @@ TEST(ReadFrameListTest, MalformedLinesNameFileAndLine) {
                       read);
   ExpectBadLineErrors("images.txt", first, InputError::Kind::kNotMonotonic,
                       {{"same_time", "1.5 images/b.png"}, {"backwards", "1.4 images/b.png"}}, read);
-  testing::ExpectInputError([&] { ReadFrameList("/no/such/images.txt"); },
-                            InputError::Kind::kMissingFile, "/no/such/images.txt", 0);
+  test::ExpectInputError([&] { ReadFrameList("/no/such/images.txt"); },
+                         InputError::Kind::kMissingFile, "/no/such/images.txt", 0);
 }
 
 TEST(ReadFrameListTest, TruncatedLastLineIsMalformed) {
   // A file cut short while it was written: the last line lacks its path and its newline.
   const std::string path =
       TextFile("frames_truncated", "images.txt", "1.5 images/a.png\n2.5 images/b.png\n3.");
-  testing::ExpectInputError([&] { ReadFrameList(path); }, InputError::Kind::kMalformed, path, 3);
+  test::ExpectInputError([&] { ReadFrameList(path); }, InputError::Kind::kMalformed, path, 3);
 }
 
 TEST(ReadFrameListTest, MegabyteLinesAndBinaryGarbageGiveShortMessages) {
@@ -98,8 +98,8 @@ TEST(ReadFrameListTest, MegabyteLinesAndBinaryGarbageGiveShortMessages) {
     SCOPED_TRACE(c.name);
     const std::string path = TextFile(std::string("frames_") + c.name, "images.txt",
                                       "1.5 images/a.png\n" + c.bad_line + "\n");
-    testing::ExpectInputError([&] { ReadFrameList(path); }, InputError::Kind::kMalformed, path, 2);
-    testing::ExpectShortPrintableMessage(testing::CatchInputError([&] { ReadFrameList(path); }));
+    test::ExpectInputError([&] { ReadFrameList(path); }, InputError::Kind::kMalformed, path, 2);
+    test::ExpectShortPrintableMessage(test::CatchInputError([&] { ReadFrameList(path); }));
   }
 }
 
@@ -112,8 +112,8 @@ TEST(ReadFrameListTest, StreamsInMemoryReadLikeTheFile) {
   ReadExposures(exposures, "memory/exposures.txt", &frames);
   EXPECT_TRUE(frames[1].has_exposure);
   std::istringstream bad("1.5 images/a.png\n1.5 images/b.png\n");
-  testing::ExpectInputError([&] { ReadFrameList(bad, "memory/images.txt"); },
-                            InputError::Kind::kNotMonotonic, "memory/images.txt", 2);
+  test::ExpectInputError([&] { ReadFrameList(bad, "memory/images.txt"); },
+                         InputError::Kind::kNotMonotonic, "memory/images.txt", 2);
 }
 
 TEST(ReadExposuresTest, MatchesByPath) {
@@ -165,10 +165,10 @@ TEST(WriteFrameListTest, RoundTripsWithTheFewestDigits) {
   frames[0].exposure_end_ns = 651782000;
   frames[1].t_ns = 644956000;
   frames[1].path = "images/frame_00000014.png";
-  const std::string dir = testing::ScratchDir("frames_write");
+  const std::string dir = test::ScratchDir("frames_write");
   WriteFrameList(dir + "/images.txt", frames);
   WriteExposures(dir + "/exposures.txt", frames);
-  EXPECT_EQ(testing::ReadFile(dir + "/images.txt"),
+  EXPECT_EQ(test::ReadFile(dir + "/images.txt"),
             "0.600891 images/frame_00000013.png\n0.644956 images/frame_00000014.png\n");
   std::vector<FrameInfo> read = ReadFrameList(dir + "/images.txt");
   ReadExposures(dir + "/exposures.txt", &read);
@@ -181,9 +181,9 @@ TEST(WriteFrameListTest, SharedImagesTxtRewritesByteIdentically) {
     SCOPED_TRACE(folder);
     const std::string images_txt = data_dir + "/" + folder + "/images.txt";
     const std::string rewritten =
-        testing::ScratchDir(std::string("frames_shared_") + folder) + "/i.txt";
+        test::ScratchDir(std::string("frames_shared_") + folder) + "/i.txt";
     WriteFrameList(rewritten, ReadFrameList(images_txt));
-    EXPECT_EQ(testing::ReadFile(rewritten), testing::ReadFile(images_txt));
+    EXPECT_EQ(test::ReadFile(rewritten), test::ReadFile(images_txt));
   }
 }
 

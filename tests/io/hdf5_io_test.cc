@@ -26,7 +26,7 @@ struct Recording {
 // Events with nanosecond timestamps, an 8-bit and a 16-bit frame, one with an exposure.
 Recording MakeRecording(uint32_t seed, int num_events) {
   Recording recording;
-  recording.events = testing::MakeRandomEvents(seed, num_events, kWidth, kHeight, 2713584001, 9999);
+  recording.events = test::MakeRandomEvents(seed, num_events, kWidth, kHeight, 2713584001, 9999);
   recording.frames.resize(2);
   recording.frames[0].t_ns = 2713576000;
   recording.frames[0].path = "images/frame_00000000.png";
@@ -35,8 +35,8 @@ Recording MakeRecording(uint32_t seed, int num_events) {
   recording.frames[0].exposure_end_ns = 2727152000;
   recording.frames[1].t_ns = 2752341000;
   recording.frames[1].path = "images/frame_00000001.png";
-  recording.images = {testing::MakeRandomImage(seed + 1, kWidth, kHeight, 8),
-                      testing::MakeRandomImage(seed + 2, kWidth, kHeight, 16)};
+  recording.images = {test::MakeRandomImage(seed + 1, kWidth, kHeight, 8),
+                      test::MakeRandomImage(seed + 2, kWidth, kHeight, 16)};
   return recording;
 }
 
@@ -93,7 +93,7 @@ void WriteRawEvents(const std::string& path, const std::vector<T>& ts, hid_t ts_
 
 TEST(Hdf5IoTest, RoundTripIsLossless) {
   const Recording recording = MakeRecording(1, 5000);
-  const std::string path = testing::ScratchDir("h5_roundtrip") + "/recording.h5";
+  const std::string path = test::ScratchDir("h5_roundtrip") + "/recording.h5";
   WriteHdf5(path, recording.events, recording.frames, recording.images);
 
   const Hdf5DataSource source(path);
@@ -109,9 +109,8 @@ TEST(Hdf5IoTest, RoundTripIsLossless) {
 }
 
 TEST(Hdf5IoTest, WindowedReadEqualsSlicingTheFullRead) {
-  const EventStream events =
-      testing::MakeRandomEvents(8, 200000, kWidth, kHeight, 1000000000, 20000);
-  const std::string path = testing::ScratchDir("h5_window") + "/events.h5";
+  const EventStream events = test::MakeRandomEvents(8, 200000, kWidth, kHeight, 1000000000, 20000);
+  const std::string path = test::ScratchDir("h5_window") + "/events.h5";
   WriteHdf5(path, events, {}, {});
   const Hdf5DataSource source(path);
   const EventStream all = source.ReadAllEvents();
@@ -136,8 +135,8 @@ TEST(Hdf5IoTest, WindowedReadEqualsSlicingTheFullRead) {
 }
 
 TEST(Hdf5IoTest, WindowedReadKeepsWholeRunsOfEqualTimestamps) {
-  const std::string path = testing::ScratchDir("h5_runs") + "/events.h5";
-  testing::ExpectWindowsKeepWholeRuns(
+  const std::string path = test::ScratchDir("h5_runs") + "/events.h5";
+  test::ExpectWindowsKeepWholeRuns(
       kWidth, kHeight, [&](const EventStream& events) { WriteHdf5(path, events, {}, {}); },
       [&](int64_t t_begin_ns, int64_t t_end_ns) {
         return Hdf5DataSource(path).ReadEvents(t_begin_ns, t_end_ns);
@@ -148,14 +147,14 @@ TEST(Hdf5IoTest, TimesBeyondExactDoublesAreStoredAsIntegerNanoseconds) {
   EventStream events(kWidth, kHeight);
   events.push_back(4000000000000000001, 1, 2, 1);  // ~127 years: float64 seconds would round
   events.push_back(4000000000000000002, 3, 4, -1);
-  const std::string path = testing::ScratchDir("h5_int_ns") + "/events.h5";
+  const std::string path = test::ScratchDir("h5_int_ns") + "/events.h5";
   WriteHdf5(path, events, {}, {});
   EXPECT_EQ(DatasetType(path, "events/ts").first, H5T_INTEGER);
   EXPECT_EQ(Hdf5DataSource(path).ReadAllEvents(), events);
 }
 
 TEST(Hdf5IoTest, ReadsFilesOfOtherTools) {
-  const std::string dir = testing::ScratchDir("h5_other_tools");
+  const std::string dir = test::ScratchDir("h5_other_tools");
   const std::vector<uint16_t> xs = {1, 5, 9};
   const std::vector<uint16_t> ys = {2, 6, 7};
   const std::vector<int8_t> minus_one_one = {-1, 1, -1};
@@ -186,7 +185,7 @@ TEST(Hdf5IoTest, ReadsFilesOfOtherTools) {
 }
 
 TEST(Hdf5IoTest, InvalidEventsAreInputErrors) {
-  const std::string dir = testing::ScratchDir("h5_invalid_events");
+  const std::string dir = test::ScratchDir("h5_invalid_events");
   const std::vector<uint16_t> xs = {1, 5, 9};
   const std::vector<uint16_t> ys = {2, 6, 7};
   WriteRawEvents(dir + "/polarity.h5", std::vector<double>{0.1, 0.2, 0.3}, H5T_NATIVE_DOUBLE, xs,
@@ -195,12 +194,12 @@ TEST(Hdf5IoTest, InvalidEventsAreInputErrors) {
                  ys, std::vector<int8_t>{0, 1, 1}, H5T_NATIVE_INT8, nullptr);
   WriteRawEvents(dir + "/unit.h5", std::vector<int64_t>{1, 2, 3}, H5T_NATIVE_INT64, xs, ys,
                  std::vector<int8_t>{0, 1, 1}, H5T_NATIVE_INT8, "fortnights");
-  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/polarity.h5"); },
-                            InputError::Kind::kOutOfRange, "events/ps[1]", 0);
-  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/backwards.h5"); },
-                            InputError::Kind::kNotMonotonic, "events/ts[2]", 0);
-  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/unit.h5"); },
-                            InputError::Kind::kMalformed, "ts_unit", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(dir + "/polarity.h5"); },
+                         InputError::Kind::kOutOfRange, "events/ps[1]", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(dir + "/backwards.h5"); },
+                         InputError::Kind::kNotMonotonic, "events/ts[2]", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(dir + "/unit.h5"); },
+                         InputError::Kind::kMalformed, "ts_unit", 0);
 
   // Coordinates outside sensor_resolution.
   EventStream events(kWidth, kHeight);
@@ -208,8 +207,8 @@ TEST(Hdf5IoTest, InvalidEventsAreInputErrors) {
   events.push_back(2000, kWidth, 0, 1);
   WriteHdf5(dir + "/outside.h5", events, {}, {});
   const Hdf5DataSource source(dir + "/outside.h5");
-  testing::ExpectInputError([&] { source.ReadAllEvents(); }, InputError::Kind::kOutOfRange,
-                            "events/xs[1]", 0);
+  test::ExpectInputError([&] { source.ReadAllEvents(); }, InputError::Kind::kOutOfRange,
+                         "events/xs[1]", 0);
   EXPECT_EQ(source.ReadEvents(0, 1500).size(), 1u);
 }
 
@@ -221,9 +220,9 @@ herr_t CountHdf5Errors(hid_t, void* count) {
 // libhdf5's automatic error printing belongs to the process: evfs silences it only while it
 // calls libhdf5 itself, and puts back whatever handler was installed before.
 TEST(Hdf5IoTest, Hdf5ErrorPrintingIsSilencedOnlyWhileEvfsCallsLibhdf5) {
-  const std::string dir = testing::ScratchDir("h5_error_scope");
+  const std::string dir = test::ScratchDir("h5_error_scope");
   const std::string garbage = dir + "/garbage.h5";
-  testing::WriteFile(garbage, std::string(4096, 'x'));
+  test::WriteFile(garbage, std::string(4096, 'x'));
   H5E_auto2_t saved = nullptr;
   void* saved_data = nullptr;
   ASSERT_GE(H5Eget_auto2(H5E_DEFAULT, &saved, &saved_data), 0);
@@ -231,12 +230,12 @@ TEST(Hdf5IoTest, Hdf5ErrorPrintingIsSilencedOnlyWhileEvfsCallsLibhdf5) {
   ASSERT_GE(H5Eset_auto2(H5E_DEFAULT, CountHdf5Errors, &errors), 0);
 
   // evfs' own failing calls report nothing through the handler...
-  testing::ExpectInputError([&] { Hdf5DataSource source(garbage); }, InputError::Kind::kMalformed,
-                            garbage, 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(garbage); }, InputError::Kind::kMalformed,
+                         garbage, 0);
   EXPECT_FALSE(IsHdf5WrittenByEvfs(garbage));
   const std::string unwritable = dir + "/no/such/folder/out.h5";
-  testing::ExpectInputError([&] { WriteHdf5(unwritable, EventStream(), {}, {}); },
-                            InputError::Kind::kUnwritable, unwritable, 0);
+  test::ExpectInputError([&] { WriteHdf5(unwritable, EventStream(), {}, {}); },
+                         InputError::Kind::kUnwritable, unwritable, 0);
   EXPECT_EQ(errors, 0);
   // ...and leave it installed, so that a failing call of the process's own is still reported.
   H5E_auto2_t current = nullptr;
@@ -265,7 +264,7 @@ TEST(Hdf5IoTest, ScopedLibhdf5ReadMarksTheCallingThreadOnly) {
   }
   EXPECT_FALSE(InLibhdf5());
   // Reading leaves no mark behind, on success or failure.
-  const std::string dir = testing::ScratchDir("h5_marks");
+  const std::string dir = test::ScratchDir("h5_marks");
   const Recording recording = MakeRecording(3, 1000);
   WriteHdf5(dir + "/good.h5", recording.events, recording.frames, recording.images);
   {
@@ -273,24 +272,24 @@ TEST(Hdf5IoTest, ScopedLibhdf5ReadMarksTheCallingThreadOnly) {
     EXPECT_EQ(source.ReadAllEvents().size(), recording.events.size());
     EXPECT_FALSE(InLibhdf5());
   }
-  testing::WriteFile(dir + "/garbage.h5", std::string(4096, 'x'));
+  test::WriteFile(dir + "/garbage.h5", std::string(4096, 'x'));
   EXPECT_THROW(Hdf5DataSource source(dir + "/garbage.h5"), InputError);
   EXPECT_FALSE(InLibhdf5());
 }
 
 // A folder (or FIFO) named like an HDF5 file exists: saying it does not would mislead.
 TEST(Hdf5IoTest, FolderNamedLikeAnHdf5FileIsNotAMissingFile) {
-  const std::string dir = testing::ScratchDir("h5_folder");
+  const std::string dir = test::ScratchDir("h5_folder");
   const std::string folder = dir + "/recording.h5";
   std::filesystem::create_directories(folder);
-  const InputError error = testing::CatchInputError([&] { Hdf5DataSource source(folder); });
+  const InputError error = test::CatchInputError([&] { Hdf5DataSource source(folder); });
   EXPECT_EQ(error.kind(), InputError::Kind::kMalformed);
   EXPECT_NE(std::string(error.what()).find("not a regular file"), std::string::npos)
       << error.what();
 }
 
 TEST(Hdf5IoTest, CorruptOrIncompleteFilesAreInputErrors) {
-  const std::string dir = testing::ScratchDir("h5_corrupt");
+  const std::string dir = test::ScratchDir("h5_corrupt");
   const Recording recording = MakeRecording(2, 100000);
   const std::string good = dir + "/good.h5";
   WriteHdf5(good, recording.events, recording.frames, recording.images);
@@ -298,13 +297,13 @@ TEST(Hdf5IoTest, CorruptOrIncompleteFilesAreInputErrors) {
   const std::string truncated = dir + "/truncated.h5";
   std::filesystem::copy_file(good, truncated);
   std::filesystem::resize_file(truncated, std::filesystem::file_size(good) / 2);
-  testing::ExpectInputError([&] { Hdf5DataSource source(truncated); }, InputError::Kind::kMalformed,
-                            truncated, 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(truncated); }, InputError::Kind::kMalformed,
+                         truncated, 0);
 
   const std::string garbage = dir + "/garbage.h5";
-  testing::WriteFile(garbage, std::string(4096, 'x'));
-  testing::ExpectInputError([&] { Hdf5DataSource source(garbage); }, InputError::Kind::kMalformed,
-                            garbage, 0);
+  test::WriteFile(garbage, std::string(4096, 'x'));
+  test::ExpectInputError([&] { Hdf5DataSource source(garbage); }, InputError::Kind::kMalformed,
+                         garbage, 0);
 
   const std::string missing_dataset = dir + "/missing_dataset.h5";
   std::filesystem::copy_file(good, missing_dataset);
@@ -312,19 +311,18 @@ TEST(Hdf5IoTest, CorruptOrIncompleteFilesAreInputErrors) {
   ASSERT_GE(file, 0);
   ASSERT_GE(H5Ldelete(file, "events/ps", H5P_DEFAULT), 0);
   H5Fclose(file);
-  const InputError error =
-      testing::CatchInputError([&] { Hdf5DataSource source(missing_dataset); });
+  const InputError error = test::CatchInputError([&] { Hdf5DataSource source(missing_dataset); });
   EXPECT_EQ(error.kind(), InputError::Kind::kMalformed);
   EXPECT_NE(std::string(error.what()).find("events/ps"), std::string::npos) << error.what();
 
-  testing::ExpectInputError([&] { Hdf5DataSource source(dir + "/nope.h5"); },
-                            InputError::Kind::kMissingFile, dir + "/nope.h5", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(dir + "/nope.h5"); },
+                         InputError::Kind::kMissingFile, dir + "/nope.h5", 0);
 }
 
 // A dataset created but never (or only partly) written reads as fill values; the reader must
 // call that an incomplete file, not zeros (a 7 KB file could otherwise claim a 65536x65536 frame).
 TEST(Hdf5IoTest, DeclaredButUnwrittenDataIsAnInputError) {
-  const std::string dir = testing::ScratchDir("h5_unwritten");
+  const std::string dir = test::ScratchDir("h5_unwritten");
   const Recording recording = MakeRecording(6, 100);
   // Replaces dataset `name` of a fresh copy of the recording by one of `dims` and `type`, chunked
   // by `chunk`, of which only the first chunk is written when `write_first_chunk`.
@@ -354,7 +352,7 @@ TEST(Hdf5IoTest, DeclaredButUnwrittenDataIsAnInputError) {
     H5Pclose(properties);
     H5Sclose(space);
     H5Fclose(file);
-    return testing::CatchInputError([&] { Hdf5DataSource source(path); });
+    return test::CatchInputError([&] { Hdf5DataSource source(path); });
   };
   const struct {
     const char* file_name;
@@ -382,12 +380,12 @@ TEST(Hdf5IoTest, DeclaredButUnwrittenDataIsAnInputError) {
 
 // Image names and paths end up in messages and file names, so they must be printable text.
 TEST(Hdf5IoTest, UnprintableImageNamesAndPathsAreMalformed) {
-  const std::string dir = testing::ScratchDir("h5_names");
+  const std::string dir = test::ScratchDir("h5_names");
   Recording recording = MakeRecording(5, 10);
   recording.frames[1].path = "images/\x1b[2Jb.png";
   WriteHdf5(dir + "/path.h5", recording.events, recording.frames, recording.images);
   const InputError path_error =
-      testing::CatchInputError([&] { Hdf5DataSource source(dir + "/path.h5"); });
+      test::CatchInputError([&] { Hdf5DataSource source(dir + "/path.h5"); });
   EXPECT_EQ(path_error.kind(), InputError::Kind::kMalformed);
   EXPECT_NE(std::string(path_error.what()).find("images/\\x1b[2Jb.png' holds a control"),
             std::string::npos)
@@ -402,7 +400,7 @@ TEST(Hdf5IoTest, UnprintableImageNamesAndPathsAreMalformed) {
                       H5P_DEFAULT, H5P_DEFAULT),
               0);
     H5Fclose(file);
-    return testing::CatchInputError([&] { Hdf5DataSource source(path); });
+    return test::CatchInputError([&] { Hdf5DataSource source(path); });
   };
   const InputError control = renamed("control", "image\x01");
   EXPECT_EQ(control.kind(), InputError::Kind::kMalformed);
@@ -418,12 +416,12 @@ TEST(Hdf5IoTest, UnprintableImageNamesAndPathsAreMalformed) {
 
 TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {
   Recording recording = MakeRecording(3, 10);
-  recording.images[1] = testing::MakeRandomImage(4, kWidth + 1, kHeight, 8);
-  const std::string path = testing::ScratchDir("h5_size") + "/recording.h5";
+  recording.images[1] = test::MakeRandomImage(4, kWidth + 1, kHeight, 8);
+  const std::string path = test::ScratchDir("h5_size") + "/recording.h5";
   WriteHdf5(path, recording.events, recording.frames, recording.images);
   // Found when the file opens, before any frame is read (issue 14).
-  testing::ExpectInputError([&] { Hdf5DataSource source(path); },
-                            InputError::Kind::kSizeMismatch, "images/image000000001", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kSizeMismatch,
+                         "images/image000000001", 0);
 }
 
 // A compressed dataset may declare any extent (its stored size says nothing about it). One of
@@ -431,7 +429,7 @@ TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {
 // H5Dread wrote past the image: it must be an error, whether it is the first image (which sets
 // the sensor size) or a later one.
 TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
-  const std::string dir = testing::ScratchDir("h5_huge_extent");
+  const std::string dir = test::ScratchDir("h5_huge_extent");
   const Recording recording = MakeRecording(7, 10);
   const auto with_huge_image = [&](const std::string& file_name, const std::string& name) {
     const std::string path = dir + "/" + file_name;
@@ -462,21 +460,18 @@ TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
   };
   // With the sensor size in the file, every image is checked against it when the file opens.
   const std::string first = with_huge_image("first.h5", "images/image000000000");
-  testing::ExpectInputError([&] { Hdf5DataSource source(first); },
-                            InputError::Kind::kSizeMismatch,
-                            "images/image000000000 is 64x4294967344", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(first); }, InputError::Kind::kSizeMismatch,
+                         "images/image000000000 is 64x4294967344", 0);
   // Without, the first image sets it.
   const std::string unsized = with_huge_image("unsized.h5", "images/image000000000");
   const hid_t file = H5Fopen(unsized.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   EXPECT_GE(H5Adelete(file, "sensor_resolution"), 0);
   H5Fclose(file);
-  testing::ExpectInputError([&] { Hdf5DataSource source(unsized); },
-                            InputError::Kind::kMalformed, "each side must be 1 to 65536 pixels",
-                            0);
+  test::ExpectInputError([&] { Hdf5DataSource source(unsized); }, InputError::Kind::kMalformed,
+                         "each side must be 1 to 65536 pixels", 0);
   const std::string later = with_huge_image("later.h5", "images/image000000001");
-  testing::ExpectInputError([&] { Hdf5DataSource source(later); },
-                            InputError::Kind::kSizeMismatch,
-                            "images/image000000001 is 64x4294967344", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(later); }, InputError::Kind::kSizeMismatch,
+                         "images/image000000001 is 64x4294967344", 0);
 }
 
 // Rewrites the root attribute sensor_resolution of `path` as [height, width].
@@ -486,8 +481,8 @@ void DeclareSensorResolution(const std::string& path, int64_t height, int64_t wi
   const hsize_t two = 2;
   const int64_t resolution[2] = {height, width};
   const hid_t space = H5Screate_simple(1, &two, nullptr);
-  const hid_t attribute = H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space,
-                                     H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t attribute =
+      H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
   H5Awrite(attribute, H5T_NATIVE_INT64, resolution);
   H5Aclose(attribute);
   H5Sclose(space);
@@ -498,23 +493,23 @@ void DeclareSensorResolution(const std::string& path, int64_t height, int64_t wi
 // a frame was read, and `evfs info --first` allocated for its 4 G pixels first (bad_alloc).
 // Declared sizes are checked against the frames and bounded when the file opens.
 TEST(Hdf5IoTest, DeclaredSensorSizeIsCheckedBeforeAllocating) {
-  const std::string dir = testing::ScratchDir("h5_declared_size");
+  const std::string dir = test::ScratchDir("h5_declared_size");
   const Recording recording = MakeRecording(5, 100);
   const std::string framed = dir + "/framed.h5";
   WriteHdf5(framed, recording.events, recording.frames, recording.images);
   DeclareSensorResolution(framed, 65535, 65535);
-  testing::ExpectInputError([&] { Hdf5DataSource source(framed); },
-                            InputError::Kind::kOutOfRange, "65535x65535 sensor", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(framed); }, InputError::Kind::kOutOfRange,
+                         "65535x65535 sensor", 0);
   // Within the bound, the frames must still have the declared size.
   DeclareSensorResolution(framed, 4096, 8192);
-  testing::ExpectInputError([&] { Hdf5DataSource source(framed); },
-                            InputError::Kind::kSizeMismatch, "the sensor is 8192x4096", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(framed); }, InputError::Kind::kSizeMismatch,
+                         "the sensor is 8192x4096", 0);
   // Without frames, too: a size beyond any sensor is refused.
   const std::string huge = dir + "/huge.h5";
   WriteHdf5(huge, recording.events, {}, {});
   DeclareSensorResolution(huge, 65535, 65535);
-  testing::ExpectInputError([&] { Hdf5DataSource source(huge); },
-                            InputError::Kind::kOutOfRange, "65535x65535 sensor", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(huge); }, InputError::Kind::kOutOfRange,
+                         "65535x65535 sensor", 0);
   // A declared sensor larger than the events need, within the bound, is a sensor.
   const std::string larger = dir + "/larger.h5";
   WriteHdf5(larger, recording.events, {}, {});
@@ -530,8 +525,8 @@ TEST(Hdf5IoTest, DeclaredSensorSizeIsCheckedBeforeAllocating) {
 TEST(Hdf5IoTest, FuzzerFindingImageExtentWrapsIntIsAnInputError) {
   const std::string path =
       std::string(EVFS_TEST_SOURCE_DIR) + "/data/fuzz_image_extent_wraps_int.h5";
-  testing::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kMalformed,
-                            "unreadable type of images/image000000001", 0);
+  test::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kMalformed,
+                         "unreadable type of images/image000000001", 0);
 }
 
 // The file the HDF5 fuzzer found it with: events/xs holds 16-bit integers at bit offset 1 of a
@@ -540,19 +535,18 @@ TEST(Hdf5IoTest, FuzzerFindingImageExtentWrapsIntIsAnInputError) {
 TEST(Hdf5IoTest, FuzzerFindingIntegerBitsBeyondTheirTypeIsAnInputError) {
   const std::string path =
       std::string(EVFS_TEST_SOURCE_DIR) + "/data/fuzz_integer_bits_beyond_type.h5";
-  testing::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kMalformed,
-                            "corrupt type of events/xs: 16 bits at bit offset 1 do not fit in 2 "
-                            "bytes",
-                            0);
+  test::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kMalformed,
+                         "corrupt type of events/xs: 16 bits at bit offset 1 do not fit in 2 "
+                         "bytes",
+                         0);
 }
 
 TEST(Hdf5IoTest, UnwritablePathIsAnInputError) {
-  const std::string path = testing::ScratchDir("h5_unwritable") + "/no/folder/out.h5";
-  testing::ExpectInputError([&] { WriteHdf5(path, EventStream(), {}, {}); },
-                            InputError::Kind::kUnwritable, path, 0);
+  const std::string path = test::ScratchDir("h5_unwritable") + "/no/folder/out.h5";
+  test::ExpectInputError([&] { WriteHdf5(path, EventStream(), {}, {}); },
+                         InputError::Kind::kUnwritable, path, 0);
   EXPECT_THROW(WriteHdf5(path, EventStream(), std::vector<FrameInfo>(1), {}), InvalidArgumentError);
 }
 
 }  // namespace
 }  // namespace evfs
-

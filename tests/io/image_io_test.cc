@@ -18,9 +18,9 @@ constexpr int kHeight = 23;
 constexpr double kHalf16BitLevel = 0.5 / 65535.0;
 
 TEST(ImageIoTest, EightAndSixteenBitRoundTripsAreExact) {
-  const std::string dir = testing::ScratchDir("image_roundtrip");
-  const Image image8 = testing::MakeRandomImage(1, kWidth, kHeight, 8);
-  const Image image16 = testing::MakeRandomImage(2, kWidth, kHeight, 16);
+  const std::string dir = test::ScratchDir("image_roundtrip");
+  const Image image8 = test::MakeRandomImage(1, kWidth, kHeight, 8);
+  const Image image16 = test::MakeRandomImage(2, kWidth, kHeight, 16);
   WriteGreyPng8(dir + "/a.png", image8);
   WriteGreyPng16(dir + "/b.png", image16);
   EXPECT_TRUE((ReadGreyImage(dir + "/a.png") == image8).all());
@@ -30,9 +30,9 @@ TEST(ImageIoTest, EightAndSixteenBitRoundTripsAreExact) {
 }
 
 TEST(ImageIoTest, LosslessWriterPicksTheBitDepth) {
-  const std::string dir = testing::ScratchDir("image_lossless");
-  const Image image8 = testing::MakeRandomImage(3, kWidth, kHeight, 8);
-  const Image image16 = testing::MakeRandomImage(4, kWidth, kHeight, 16);
+  const std::string dir = test::ScratchDir("image_lossless");
+  const Image image8 = test::MakeRandomImage(3, kWidth, kHeight, 8);
+  const Image image16 = test::MakeRandomImage(4, kWidth, kHeight, 16);
   EXPECT_EQ(MinimalBitDepth(image8), 8);
   EXPECT_EQ(MinimalBitDepth(image16), 16);
   WriteGreyPngLossless(dir + "/a.png", image8);
@@ -43,7 +43,7 @@ TEST(ImageIoTest, LosslessWriterPicksTheBitDepth) {
 }
 
 TEST(ImageIoTest, ValuesAreClampedAndRounded) {
-  const std::string dir = testing::ScratchDir("image_clamp");
+  const std::string dir = test::ScratchDir("image_clamp");
   Image image(1, 3);
   image << -0.5, 0.3, 1.7;
   EXPECT_EQ(MinimalBitDepth(image), 16);
@@ -55,7 +55,7 @@ TEST(ImageIoTest, ValuesAreClampedAndRounded) {
 }
 
 TEST(ImageIoTest, ColourIsConvertedToGrey) {
-  const std::string dir = testing::ScratchDir("image_colour");
+  const std::string dir = test::ScratchDir("image_colour");
   cv::Mat colour(kHeight, kWidth, CV_8UC3, cv::Scalar(100, 100, 100));
   ASSERT_TRUE(cv::imwrite(dir + "/colour.png", colour));
   const Image grey = ReadGreyImage(dir + "/colour.png");
@@ -65,26 +65,26 @@ TEST(ImageIoTest, ColourIsConvertedToGrey) {
 }
 
 TEST(ImageIoTest, MissingOrUndecodableImageIsAnInputError) {
-  const std::string dir = testing::ScratchDir("image_missing");
-  testing::ExpectInputError([&] { ReadGreyImage(dir + "/nope.png"); },
-                            InputError::Kind::kMissingFile, dir + "/nope.png", 0);
-  testing::WriteFile(dir + "/garbage.png", "definitely not a png");
-  testing::ExpectInputError([&] { ReadGreyImage(dir + "/garbage.png"); },
-                            InputError::Kind::kMissingFile, dir + "/garbage.png", 0);
+  const std::string dir = test::ScratchDir("image_missing");
+  test::ExpectInputError([&] { ReadGreyImage(dir + "/nope.png"); }, InputError::Kind::kMissingFile,
+                         dir + "/nope.png", 0);
+  test::WriteFile(dir + "/garbage.png", "definitely not a png");
+  test::ExpectInputError([&] { ReadGreyImage(dir + "/garbage.png"); },
+                         InputError::Kind::kMissingFile, dir + "/garbage.png", 0);
 }
 
 TEST(ImageIoTest, UnwritableImageIsAnInputError) {
-  const std::string path = testing::ScratchDir("image_unwritable") + "/no/folder/a.png";
-  testing::ExpectInputError([&] { WriteGreyPng16(path, Image::Zero(2, 2)); },
-                            InputError::Kind::kUnwritable, path, 0);
-  testing::ExpectInputError([&] { WriteGreyPng8(path, Image::Zero(2, 2)); },
-                            InputError::Kind::kUnwritable, path, 0);
+  const std::string path = test::ScratchDir("image_unwritable") + "/no/folder/a.png";
+  test::ExpectInputError([&] { WriteGreyPng16(path, Image::Zero(2, 2)); },
+                         InputError::Kind::kUnwritable, path, 0);
+  test::ExpectInputError([&] { WriteGreyPng8(path, Image::Zero(2, 2)); },
+                         InputError::Kind::kUnwritable, path, 0);
 }
 
 TEST(ImageIoTest, TimestampsFileHasIndexAndNineDecimals) {
-  const std::string path = testing::ScratchDir("image_timestamps") + "/timestamps.txt";
+  const std::string path = test::ScratchDir("image_timestamps") + "/timestamps.txt";
   WriteTimestampsTxt(path, {2713576000, 2752341001});
-  EXPECT_EQ(testing::ReadFile(path), "0 2.713576000\n1 2.752341001\n");
+  EXPECT_EQ(test::ReadFile(path), "0 2.713576000\n1 2.752341001\n");
 }
 
 TEST(ImageIoTest, SharedFramesAreEightBitOfTheSensorSize) {

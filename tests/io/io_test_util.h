@@ -15,7 +15,7 @@
 #include "core/video.h"
 
 namespace evfs {
-namespace testing {
+namespace test {
 
 /// Random events in time order: gaps uniform in [0, max_gap_ns] (so equal timestamps occur),
 /// starting at t_first_ns, on a width x height sensor.
@@ -127,7 +127,7 @@ inline void ExpectShortPrintableMessage(const InputError& error) {
   }
 }
 
-}  // namespace testing
+}  // namespace test
 }  // namespace evfs
 
 #endif  // EVFS_TESTS_IO_IO_TEST_UTIL_H_

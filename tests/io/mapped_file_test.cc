@@ -12,23 +12,23 @@ namespace evfs {
 namespace {
 
 TEST(MappedFileTest, MapsTheWholeFile) {
-  const std::string path = testing::ScratchDir("mapped_whole") + "/data.txt";
-  testing::WriteFile(path, "0.5 1 2 1\n0.6 3 4 0");
+  const std::string path = test::ScratchDir("mapped_whole") + "/data.txt";
+  test::WriteFile(path, "0.5 1 2 1\n0.6 3 4 0");
   const MappedFile file(path);
   EXPECT_EQ(file.path(), path);
   EXPECT_EQ(std::string(file.data(), file.size()), "0.5 1 2 1\n0.6 3 4 0");
 }
 
 TEST(MappedFileTest, EmptyFileGivesAnEmptyBuffer) {
-  const std::string path = testing::ScratchDir("mapped_empty") + "/empty.txt";
-  testing::WriteFile(path, "");
+  const std::string path = test::ScratchDir("mapped_empty") + "/empty.txt";
+  test::WriteFile(path, "");
   const MappedFile file(path);
   EXPECT_EQ(file.size(), 0u);
 }
 
 TEST(MappedFileTest, MovingTransfersTheMapping) {
-  const std::string path = testing::ScratchDir("mapped_move") + "/data.txt";
-  testing::WriteFile(path, "abc");
+  const std::string path = test::ScratchDir("mapped_move") + "/data.txt";
+  test::WriteFile(path, "abc");
   MappedFile first(path);
   MappedFile second(std::move(first));
   EXPECT_EQ(std::string(second.data(), second.size()), "abc");
@@ -49,10 +49,10 @@ TEST(MappedFileTest, FromMemoryWrapsTheBytesWithoutCopying) {
 }
 
 TEST(MappedFileTest, MissingFileOrFolderIsAnInputError) {
-  const std::string dir = testing::ScratchDir("mapped_missing");
-  testing::ExpectInputError([&] { MappedFile file(dir + "/nope.txt"); },
-                            InputError::Kind::kMissingFile, dir + "/nope.txt", 0);
-  testing::ExpectInputError([&] { MappedFile file(dir); }, InputError::Kind::kMissingFile, dir, 0);
+  const std::string dir = test::ScratchDir("mapped_missing");
+  test::ExpectInputError([&] { MappedFile file(dir + "/nope.txt"); },
+                         InputError::Kind::kMissingFile, dir + "/nope.txt", 0);
+  test::ExpectInputError([&] { MappedFile file(dir); }, InputError::Kind::kMissingFile, dir, 0);
 }
 
 }  // namespace

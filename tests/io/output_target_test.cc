@@ -3,6 +3,7 @@
 // are stand-ins inside it.
 #include "io/output_target.h"
 
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,8 +14,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 #include "io/signal_cleanup.h"
@@ -28,9 +27,10 @@ namespace fs = std::filesystem;
 
 // A sandbox with stand-ins for the folders evfs must never replace.
 struct Sandbox {
-  explicit Sandbox(const std::string& name) : root(testing::ScratchDir("output_" + name)) {
-    for (const char* folder : {"root", "home", "cwd", "data"}) fs::create_directories(root / folder);
-    testing::WriteFile((root / "data/events.txt").string(), "0.1 1 1 1\n");
+  explicit Sandbox(const std::string& name) : root(test::ScratchDir("output_" + name)) {
+    for (const char* folder : {"root", "home", "cwd", "data"})
+      fs::create_directories(root / folder);
+    test::WriteFile((root / "data/events.txt").string(), "0.1 1 1 1\n");
   }
 
   OutputOptions Options(const fs::path& out, const char* command = "reconstruct") const {
@@ -58,7 +58,7 @@ struct Sandbox {
 
 void WriteIn(const std::string& folder, const std::string& name, const std::string& text) {
   fs::create_directories(folder);
-  testing::WriteFile((fs::path(folder) / name).string(), text);
+  test::WriteFile((fs::path(folder) / name).string(), text);
 }
 
 // Runs `write` on a new output at `out` and commits it.
@@ -80,8 +80,8 @@ TEST(OutputTargetTest, NewFolderAppearsWholeWithItsMarker) {
     WriteIn(target.staging(), "result.txt", "new");
     target.Commit();
   }
-  EXPECT_EQ(testing::ReadFile((out / "result.txt").string()), "new");
-  EXPECT_EQ(testing::ReadFile((out / kOutputMarkerFile).string()), "evfs reconstruct\n");
+  EXPECT_EQ(test::ReadFile((out / "result.txt").string()), "new");
+  EXPECT_EQ(test::ReadFile((out / kOutputMarkerFile).string()), "evfs reconstruct\n");
   EXPECT_TRUE(sandbox.Others(out.parent_path(), "out").empty());
 }
 
@@ -101,7 +101,7 @@ TEST(OutputTargetTest, RefusesAFolderHoldingFilesEvfsDidNotWrite) {
   OutputOptions options = sandbox.Options(out);
   options.overwrite = true;  // not even then
   EXPECT_THROW(OutputTarget target(options), InvalidArgumentError);
-  EXPECT_EQ(testing::ReadFile((out / "chapter1.tex").string()), "precious");
+  EXPECT_EQ(test::ReadFile((out / "chapter1.tex").string()), "precious");
   EXPECT_TRUE(sandbox.Others(sandbox.root, "thesis").size() == 4u) << "left something behind";
 }
 
@@ -208,16 +208,16 @@ TEST(OutputTargetTest, RefusesTheInputAFolderInsideItAndOneAroundIt) {
     SCOPED_TRACE(options.path);
     EXPECT_THROW(OutputTarget target(options), InvalidArgumentError);
   }
-  EXPECT_EQ(testing::ReadFile((data / "events.txt").string()), "0.1 1 1 1\n");
+  EXPECT_EQ(test::ReadFile((data / "events.txt").string()), "0.1 1 1 1\n");
   EXPECT_FALSE(fs::exists(data / "sub"));
 }
 
 TEST(OutputTargetTest, RefusesFilesLinksAndOddNames) {
   const Sandbox sandbox("odd");
   const fs::path file = sandbox.root / "notes.txt";
-  testing::WriteFile(file.string(), "mine");
+  test::WriteFile(file.string(), "mine");
   EXPECT_THROW(OutputTarget target(sandbox.Options(file)), InvalidArgumentError);
-  EXPECT_EQ(testing::ReadFile(file.string()), "mine");
+  EXPECT_EQ(test::ReadFile(file.string()), "mine");
 
   fs::create_directory_symlink(sandbox.root / "home", sandbox.root / "link");
   EXPECT_THROW(OutputTarget target(sandbox.Options(sandbox.root / "link")), InvalidArgumentError);
@@ -233,7 +233,7 @@ TEST(OutputTargetTest, RefusesFilesLinksAndOddNames) {
 
 TEST(OutputTargetTest, AnUnwritablePlaceFailsBeforeAnyWork) {
   const Sandbox sandbox("unwritable");
-  testing::WriteFile((sandbox.root / "file").string(), "a file");
+  test::WriteFile((sandbox.root / "file").string(), "a file");
   try {
     OutputTarget target(sandbox.Options(sandbox.root / "file/out"));
     FAIL() << "accepted a path under a file";
@@ -268,28 +268,28 @@ TEST(OutputTargetTest, AFileOutputKeepsItsExtensionAndReplacesOnlyItsOwnFiles) {
   OutputOptions options = sandbox.Options(out, "convert");
   options.kind = OutputOptions::Kind::kFile;
   options.is_own_file = [](const std::string& path) {
-    return testing::ReadFile(path).rfind("evfs", 0) == 0;
+    return test::ReadFile(path).rfind("evfs", 0) == 0;
   };
   {
     OutputTarget target(options);
     EXPECT_EQ(fs::path(target.staging()).extension(), ".h5");
     EXPECT_TRUE(fs::is_regular_file(target.staging()));
-    testing::WriteFile(target.staging(), "evfs 1");
+    test::WriteFile(target.staging(), "evfs 1");
     target.Commit();
   }
-  EXPECT_EQ(testing::ReadFile(out.string()), "evfs 1");
+  EXPECT_EQ(test::ReadFile(out.string()), "evfs 1");
   EXPECT_THROW(OutputTarget target(options), InvalidArgumentError);  // no --overwrite
   options.overwrite = true;
   {
     OutputTarget target(options);
-    testing::WriteFile(target.staging(), "evfs 2");
+    test::WriteFile(target.staging(), "evfs 2");
     target.Commit();
   }
-  EXPECT_EQ(testing::ReadFile(out.string()), "evfs 2");
+  EXPECT_EQ(test::ReadFile(out.string()), "evfs 2");
 
-  testing::WriteFile(out.string(), "someone else's recording");
+  test::WriteFile(out.string(), "someone else's recording");
   EXPECT_THROW(OutputTarget target(options), InvalidArgumentError);
-  EXPECT_EQ(testing::ReadFile(out.string()), "someone else's recording");
+  EXPECT_EQ(test::ReadFile(out.string()), "someone else's recording");
   EXPECT_EQ(sandbox.Others(sandbox.root, "recording.h5").size(), 4u);
 }
 
@@ -338,7 +338,7 @@ void ExpectSignalCleansUp(int signal_number) {
   EXPECT_EQ(removed, std::vector<std::string>{staging.string()});
   EXPECT_FALSE(fs::exists(staging));
   EXPECT_EQ(sandbox.Others(sandbox.root, "out").size(), 4u) << "a staging folder was left";
-  EXPECT_EQ(testing::ReadFile((out / "old.txt").string()), "old.txt");
+  EXPECT_EQ(test::ReadFile((out / "old.txt").string()), "old.txt");
 }
 
 TEST(SignalCleanupTest, AReleasedPathIsNotRemoved) {

@@ -11,7 +11,7 @@ namespace evfs {
 namespace {
 
 TEST(TextFileWriterTest, WritesStringsAndReservedLinesInOrder) {
-  const std::string path = testing::ScratchDir("writer_order") + "/out.txt";
+  const std::string path = test::ScratchDir("writer_order") + "/out.txt";
   TextFileWriter writer(path);
   writer.Write("# header\n");
   char* line = writer.Reserve();
@@ -21,12 +21,12 @@ TEST(TextFileWriterTest, WritesStringsAndReservedLinesInOrder) {
   writer.Commit(3);
   writer.Write("end\n");
   writer.Close();
-  EXPECT_EQ(testing::ReadFile(path), "# header\n42\nend\n");
+  EXPECT_EQ(test::ReadFile(path), "# header\n42\nend\n");
 }
 
 TEST(TextFileWriterTest, LargeOutputSurvivesFlushes) {
   constexpr int kLines = 200000;  // several MiB: more than one flush
-  const std::string path = testing::ScratchDir("writer_large") + "/out.txt";
+  const std::string path = test::ScratchDir("writer_large") + "/out.txt";
   std::string expected;
   TextFileWriter writer(path);
   for (int i = 0; i < kLines; ++i) {
@@ -35,13 +35,13 @@ TEST(TextFileWriterTest, LargeOutputSurvivesFlushes) {
     writer.Write(text);
   }
   writer.Close();
-  EXPECT_EQ(testing::ReadFile(path), expected);
+  EXPECT_EQ(test::ReadFile(path), expected);
 }
 
 TEST(TextFileWriterTest, UnwritablePathIsAnInputError) {
-  const std::string path = testing::ScratchDir("writer_unwritable") + "/no/such/folder/out.txt";
-  testing::ExpectInputError([&] { TextFileWriter writer(path); }, InputError::Kind::kUnwritable,
-                            path, 0);
+  const std::string path = test::ScratchDir("writer_unwritable") + "/no/such/folder/out.txt";
+  test::ExpectInputError([&] { TextFileWriter writer(path); }, InputError::Kind::kUnwritable, path,
+                         0);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ namespace {
 constexpr double kThresholdTolerance = 0.05;
 
 TEST(EventModelEstimation, MeasuresTheSimulatorsThresholdWithTheLogModel) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
   EventModelParams log_model;
@@ -28,7 +28,7 @@ TEST(EventModelEstimation, MeasuresTheSimulatorsThresholdWithTheLogModel) {
 }
 
 TEST(EventModelEstimation, FallsBackToTheAssumedChangeWithOneFrame) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakePredictionScene(recording.Sharp(0), recording.rendered.timestamp_ns(20),
                                           recording.events, BinningOptions());
   const EventModelEstimationOptions options;

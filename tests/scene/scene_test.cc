@@ -50,16 +50,15 @@ EventStream WithHotPixel(const EventStream& events, int x, int y, int count, int
     all.emplace_back(begin_ns + (end_ns - begin_ns) * i / count, static_cast<uint16_t>(x),
                      static_cast<uint16_t>(y), i % 2 ? 1 : -1);
   }
-  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
-    return std::get<0>(a) < std::get<0>(b);
-  });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
   EventStream result(events.width(), events.height());
   for (const auto& [t_ns, ex, ey, polarity] : all) result.push_back(t_ns, ex, ey, polarity);
   return result;
 }
 
 TEST(Scene, InterpolationTiesFramesToTheEndsOfTheTimeline) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
   ASSERT_EQ(scene.frames.size(), 2u);
@@ -75,7 +74,7 @@ TEST(Scene, InterpolationTiesFramesToTheEndsOfTheTimeline) {
 }
 
 TEST(Scene, BlurredFrameSpansItsExposure) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   BinningOptions binning;
   binning.method = BinningOptions::Method::kStacked;
   binning.stacked.num_frames = 10;
@@ -87,22 +86,21 @@ TEST(Scene, BlurredFrameSpansItsExposure) {
 }
 
 TEST(Scene, AutoBinningFallsBackToStackedWhenCollisionFramesAreTooMany) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const int64_t end_ns = recording.rendered.timestamp_ns(20);
-  const Scene collision = MakePredictionScene(recording.Sharp(0), end_ns, recording.events,
-                                              BinningOptions());
+  const Scene collision =
+      MakePredictionScene(recording.Sharp(0), end_ns, recording.events, BinningOptions());
   ASSERT_GT(collision.events.num_frames(), 6);  // the premise: more than the limits below
   BinningOptions binning;
   binning.max_latent_frames = 5;
-  const Scene capped =
-      MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning);
+  const Scene capped = MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning);
   EXPECT_EQ(capped.events.num_frames(), 5);
   EXPECT_EQ(capped.num_latent_frames(), 6);
   EXPECT_EQ(capped.num_events, collision.num_events);
 }
 
 TEST(Scene, AutoBinningKeepsWithinTheVoxelBudget) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   BinningOptions binning;
   const int64_t pixels = recording.events.width() * recording.events.height();
   binning.max_latent_voxels = pixels * 7;  // 7 latent frames: 6 steps
@@ -118,24 +116,25 @@ TEST(Scene, AutoBinningKeepsWithinTheVoxelBudget) {
   // Not even one step fits: a user error naming the limit.
   binning.max_latent_voxels = pixels * 2 - 1;
   ExpectRefused([&] {
-    MakePredictionScene(recording.Sharp(0), recording.rendered.timestamp_ns(20),
-                        recording.events, binning);
+    MakePredictionScene(recording.Sharp(0), recording.rendered.timestamp_ns(20), recording.events,
+                        binning);
   });
 }
 
 // Regression (issue 14): an explicit binning beyond the voxel cap used to be built whatever its
 // size; it is now refused before any frame is allocated.
 TEST(Scene, ExplicitBinningBeyondTheVoxelCapIsRefused) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const int64_t pixels = recording.events.width() * recording.events.height();
   const int64_t end_ns = recording.rendered.timestamp_ns(20);
   BinningOptions binning;
   binning.method = BinningOptions::Method::kCollision;
-  const Scene collision = MakePredictionScene(recording.Sharp(0), end_ns, recording.events,
-                                              binning);
+  const Scene collision =
+      MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning);
   ASSERT_GT(collision.events.num_frames(), 6);  // the premise: more than the cap below
   binning.max_latent_voxels = pixels * 7;
-  ExpectRefused([&] { MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning); });
+  ExpectRefused(
+      [&] { MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning); });
   binning.max_latent_voxels = pixels * (collision.num_latent_frames());  // exactly fits
   EXPECT_EQ(MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning)
                 .num_latent_frames(),
@@ -149,7 +148,8 @@ TEST(Scene, ExplicitBinningBeyondTheVoxelCapIsRefused) {
                 .num_latent_frames(),
             7);
   binning.max_latent_voxels = pixels * 7 - 1;
-  ExpectRefused([&] { MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning); });
+  ExpectRefused(
+      [&] { MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning); });
   // M · S beyond int: refused by the options, not wrapped.
   binning.max_latent_voxels = std::numeric_limits<int64_t>::max();
   binning.stacked.num_frames = 1 << 20;
@@ -159,7 +159,7 @@ TEST(Scene, ExplicitBinningBeyondTheVoxelCapIsRefused) {
 }
 
 TEST(Scene, PlanBinningPredictsTheScene) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const int64_t begin_ns = recording.rendered.timestamp_ns(0);
   const int64_t end_ns = recording.rendered.timestamp_ns(20);
   // A window without events, too: its two ends are the latent frames.
@@ -184,8 +184,7 @@ TEST(Scene, PlanBinningPredictsTheScene) {
           MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning);
       EXPECT_EQ(plan.num_event_frames, scene.events.num_frames());
       EXPECT_EQ(plan.num_latent_frames, scene.num_latent_frames());
-      EXPECT_EQ(plan.collision_frames,
-                CountCollisionFrames(recording.events, begin_ns, end_ns));
+      EXPECT_EQ(plan.collision_frames, CountCollisionFrames(recording.events, begin_ns, end_ns));
       EXPECT_EQ(plan.activity.num_events, scene.num_events);
     }
   }
@@ -195,7 +194,7 @@ TEST(Scene, PlanBinningPredictsTheScene) {
 // binning open a thousand frames of the whole sensor (auto binning then fell back to stacked
 // frames). Its events are now left out as hot, and the scene is the one without it.
 TEST(Scene, HotPixelDoesNotMultiplyTheLatentSteps) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const int64_t begin_ns = recording.rendered.timestamp_ns(0);
   const int64_t end_ns = recording.rendered.timestamp_ns(20);
   const int hot_x = 3, hot_y = 2;
@@ -257,15 +256,15 @@ TEST(Scene, MemoryIsBoundedBeforeAllocating) {
 #endif
 
 TEST(Scene, RejectsBadWindowsAndSizes) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   EXPECT_THROW(MakePredictionScene(recording.Sharp(10), recording.rendered.timestamp_ns(5),
                                    recording.events, BinningOptions()),
                InvalidArgumentError);
   TimedFrame wrong_size = recording.Sharp(0);
   wrong_size.image = Image::Zero(5, 5);
-  EXPECT_THROW(MakeInterpolationScene(wrong_size, recording.Sharp(10), recording.events,
-                                      BinningOptions()),
-               InvalidArgumentError);
+  EXPECT_THROW(
+      MakeInterpolationScene(wrong_size, recording.Sharp(10), recording.events, BinningOptions()),
+      InvalidArgumentError);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include "scene/scene.h"
 
 namespace evfs {
-namespace testing {
+namespace test {
 
 /// Moving textured shapes rendered at 1 kHz for `duration_s`, with simulated events.
 struct SyntheticRecording {
@@ -54,7 +54,7 @@ struct SyntheticRecording {
   }
 };
 
-}  // namespace testing
+}  // namespace test
 }  // namespace evfs
 
 #endif  // EVFS_TESTS_SCENE_SCENE_TEST_SCENES_H_

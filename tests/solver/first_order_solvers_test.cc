@@ -43,7 +43,7 @@ SolverOptions TestOptions() {
 // The interpolation scene with α derived from the data, as Reconstruct does, and its
 // initialisation.
 struct Problem {
-  testing::SyntheticRecording recording;
+  test::SyntheticRecording recording;
   Scene scene;
   ObjectiveOptions objective;
   Video initial;

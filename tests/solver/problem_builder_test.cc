@@ -1,12 +1,12 @@
 #include "solver/problem_builder.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "tests/scene/scene_test_scenes.h"
 
@@ -48,7 +48,7 @@ TEST(ProblemBuilder, BuildsOneResidualPerTermAndPixel) {
   const Scene scene = MakeTinyScene();
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
-  options.activity_radius_px = -1;  // every pixel
+  options.activity_radius_px = -1;    // every pixel
   options.merge_quiet_steps = false;  // one parameter block per voxel
   Video latent = InitializeLatentVideo(scene);
   const auto built = ProblemBuilder(scene, options).Build(&latent);
@@ -178,8 +178,8 @@ TEST(ActivityMask, RadiusBeyondTheSensorMakesEveryPixelActive) {
   const Scene scene = MakeSceneWithEvents(6, 18, {{0, 2, 2}});
   const ActivityMask small(scene.events, 1);
   EXPECT_EQ(small.num_active(), 9);
-  for (const int radius : {18, 1000, std::numeric_limits<int>::max() - 238,
-                           std::numeric_limits<int>::max()}) {
+  for (const int radius :
+       {18, 1000, std::numeric_limits<int>::max() - 238, std::numeric_limits<int>::max()}) {
     const ActivityMask mask(scene.events, radius);
     EXPECT_EQ(mask.num_active(), 6 * 18) << radius;
   }
@@ -247,11 +247,11 @@ double EvaluateProblem(ceres::Problem* problem, const std::vector<double*>& bloc
 TEST(ProblemBuilder, MergedProblemIsTheFullProblemOnSegmentConstantVideos) {
   // On any video constant over each segment, the merged problem has the full problem's cost,
   // and its gradient is the sum of the full gradient over each segment's voxels.
-  const testing::SyntheticRecording recording(24, 20, 0.012);
+  const test::SyntheticRecording recording(24, 20, 0.012);
   TimedFrame blurred = recording.Blurred(6, 12);  // a mixed scene: sharp first, blurred last
-  const Scene scene = MakeScene({recording.Sharp(0), blurred}, recording.events,
-                                recording.rendered.timestamp_ns(0),
-                                recording.rendered.timestamp_ns(12) + 1, BinningOptions());
+  const Scene scene =
+      MakeScene({recording.Sharp(0), blurred}, recording.events, recording.rendered.timestamp_ns(0),
+                recording.rendered.timestamp_ns(12) + 1, BinningOptions());
   ReconstructionOptions options;
   options.objective.event_model.alpha = 8.0;
   Video merged_video = InitializeLatentVideo(scene);

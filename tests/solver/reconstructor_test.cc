@@ -1,9 +1,9 @@
 #include "solver/reconstructor.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 #include "core/metrics.h"
@@ -19,14 +19,13 @@ constexpr double kMinGainOverBlendDb = 4.5;
 constexpr double kMinGainOverCopyDb = 6.0;
 constexpr double kMinGainOverBlurredDb = 2.5;
 
-
-double PsnrAt(const Video& video, const testing::SyntheticRecording& recording, int truth) {
+double PsnrAt(const Video& video, const test::SyntheticRecording& recording, int truth) {
   const int index = video.NearestFrame(recording.rendered.timestamp_ns(truth));
   return Psnr(video.frame(index), recording.rendered.frame(truth));
 }
 
 TEST(Reconstructor, InterpolationBeatsTheBlend) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
   const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
@@ -41,7 +40,7 @@ TEST(Reconstructor, InterpolationBeatsTheBlend) {
 }
 
 TEST(Reconstructor, PredictionBeatsTheCopy) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakePredictionScene(recording.Sharp(0), recording.rendered.timestamp_ns(10),
                                           recording.events, BinningOptions());
   const Reconstruction result = Reconstruct(scene, ReconstructionOptions());
@@ -54,13 +53,13 @@ TEST(Reconstructor, PredictionBeatsTheCopy) {
 TEST(Reconstructor, MixedSharpAndBlurredObservationsSolveTogether) {
   // A sharp frame at the start and a frame blurred over the second half of the window: neither
   // preset, the same code path.
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   BinningOptions binning;
   binning.method = BinningOptions::Method::kStacked;
   binning.stacked.num_frames = 20;
-  const Scene scene = MakeScene({recording.Sharp(0), recording.Blurred(10, 20)}, recording.events,
-                                recording.rendered.timestamp_ns(0),
-                                recording.rendered.timestamp_ns(20), binning);
+  const Scene scene =
+      MakeScene({recording.Sharp(0), recording.Blurred(10, 20)}, recording.events,
+                recording.rendered.timestamp_ns(0), recording.rendered.timestamp_ns(20), binning);
   ASSERT_EQ(scene.frames.size(), 2u);
   EXPECT_EQ(scene.frames[1].latent_first, 10);
   EXPECT_EQ(scene.frames[1].latent_last, 20);
@@ -74,10 +73,10 @@ TEST(Reconstructor, MixedSharpAndBlurredObservationsSolveTogether) {
 }
 
 TEST(Reconstructor, WindowWithoutEventsIsAnsweredWithoutSolving) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const EventStream no_events(recording.events.width(), recording.events.height());
-  const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20), no_events,
-                                             BinningOptions());
+  const Scene scene =
+      MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20), no_events, BinningOptions());
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
   const Reconstruction result = Reconstruct(scene, options);
@@ -87,7 +86,7 @@ TEST(Reconstructor, WindowWithoutEventsIsAnsweredWithoutSolving) {
 }
 
 TEST(Reconstructor, ContinuationOnTheSmoothingScaleEndsOnTheObjectivesOwn) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
   ReconstructionOptions options;
@@ -110,7 +109,7 @@ TEST(Reconstructor, ContinuationOnTheSmoothingScaleEndsOnTheObjectivesOwn) {
 // A start Ceres cannot evaluate (NaN intensities) ends its solve with FAILURE: a solver
 // failure, not an invalid argument of the user's.
 TEST(Reconstructor, CeresFailureIsASolverError) {
-  const testing::SyntheticRecording recording;
+  const test::SyntheticRecording recording;
   const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
   ReconstructionOptions options;
@@ -129,7 +128,7 @@ TEST(Reconstructor, CeresFailureIsASolverError) {
 }
 
 // Two shapes far apart on a wide sensor: two independent regions, each its own part.
-Scene TwoRegionScene(const testing::SyntheticRecording& recording) {
+Scene TwoRegionScene(const test::SyntheticRecording& recording) {
   return MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20), recording.events,
                                 BinningOptions());
 }
@@ -142,7 +141,7 @@ ReconstructionOptions EveryRegionAPart() {
 }
 
 TEST(Reconstructor, IndependentPartsReachTheOneProblemsSolution) {
-  const testing::SyntheticRecording recording(/*width=*/120, /*height=*/40);
+  const test::SyntheticRecording recording(/*width=*/120, /*height=*/40);
   const Scene scene = TwoRegionScene(recording);
   ReconstructionOptions options = EveryRegionAPart();
   options.solver.function_tolerance = 1e-8;  // both run to convergence
@@ -164,7 +163,7 @@ TEST(Reconstructor, IndependentPartsReachTheOneProblemsSolution) {
 }
 
 TEST(Reconstructor, CallbackSeesTheWholeObjectiveAcrossParts) {
-  const testing::SyntheticRecording recording(/*width=*/120, /*height=*/40);
+  const test::SyntheticRecording recording(/*width=*/120, /*height=*/40);
   const Scene scene = TwoRegionScene(recording);
   std::vector<SolverIteration> seen;
   const Reconstruction result =

@@ -13,9 +13,9 @@
 namespace evfs {
 namespace {
 
-using testing::ExpectStableReconstruction;
-using testing::PsnrCheck;
-using testing::StressScene;
+using test::ExpectStableReconstruction;
+using test::PsnrCheck;
+using test::StressScene;
 
 // Parameter values in test names: "1e-06" → "1em06", "0.1" → "0p1".
 std::string ValueName(double value) {
@@ -40,7 +40,7 @@ TEST_P(AlphaSweep, StaysFiniteAndDoesNotDegrade) {
   ReconstructionOptions options;
   options.objective.event_model.alpha = alpha;
   options.bound_intensities = bounded;
-  ExpectStableReconstruction(testing::SimulatedInterpolation(), options, PsnrCheck::kWithinMargin,
+  ExpectStableReconstruction(test::SimulatedInterpolation(), options, PsnrCheck::kWithinMargin,
                              "alpha " + ValueName(alpha) + " " + BoundsName(bounded));
 }
 
@@ -58,7 +58,7 @@ class SmoothingScaleSweep : public ::testing::TestWithParam<double> {};
 TEST_P(SmoothingScaleSweep, StaysFiniteAndDoesNotDegrade) {
   ReconstructionOptions options;
   options.objective.smoothing_scale = GetParam();
-  ExpectStableReconstruction(testing::SimulatedInterpolation(), options, PsnrCheck::kWithinMargin,
+  ExpectStableReconstruction(test::SimulatedInterpolation(), options, PsnrCheck::kWithinMargin,
                              "epsilon " + ValueName(GetParam()));
 }
 
@@ -103,8 +103,7 @@ TEST_P(WeightSweep, StaysFiniteAndDoesNotDegrade) {
   const auto [term, weight] = GetParam();
   ReconstructionOptions options;
   options.objective.*term.weight = weight;
-  ExpectStableReconstruction(testing::SimulatedInterpolation(), options,
-                             WeightPsnrCheck(term, weight),
+  ExpectStableReconstruction(test::SimulatedInterpolation(), options, WeightPsnrCheck(term, weight),
                              std::string(term.name) + " weight " + ValueName(weight));
 }
 
@@ -126,7 +125,7 @@ TEST(WeightSweep, AllWeightsZeroIsRejected) {
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_NE(error.find("at least one term weight"), std::string::npos) << error;
-  EXPECT_THROW(Reconstruct(testing::SimulatedInterpolation().scene, options), InvalidArgumentError);
+  EXPECT_THROW(Reconstruct(test::SimulatedInterpolation().scene, options), InvalidArgumentError);
 }
 
 TEST(SolverOptions, LineSearchWithBoundsIsRejected) {
@@ -157,9 +156,8 @@ TEST_P(LogOffsetSweep, StaysFiniteAndDoesNotDegrade) {
   options.objective.event_model.model = EventModel::kLog;
   options.objective.event_model.log_offset = log_offset;
   options.bound_intensities = bounded;
-  ExpectStableReconstruction(scene == LogScene::kSimulated
-                                 ? testing::SimulatedInterpolation()
-                                 : testing::SaturatedScene(EventModel::kLog),
+  ExpectStableReconstruction(scene == LogScene::kSimulated ? test::SimulatedInterpolation()
+                                                           : test::SaturatedScene(EventModel::kLog),
                              options, PsnrCheck::kWithinMargin,
                              std::string("log b ") + ValueName(log_offset) + " " +
                                  LogSceneName(scene) + " " + BoundsName(bounded));

@@ -18,8 +18,8 @@
 namespace evfs {
 namespace {
 
-using testing::PsnrCheck;
-using testing::StressScene;
+using test::PsnrCheck;
+using test::StressScene;
 
 constexpr PsnrCheck kMargin = PsnrCheck::kWithinMargin;
 constexpr PsnrCheck kNotOptimum = PsnrCheck::kTruthNotTheOptimum;
@@ -48,26 +48,25 @@ struct SceneCase {
 //  * events_disagree_with_frames: there is no consistent truth; the frames' ramp is used, and
 //    the events pull against it (60 → 10 and 8 dB).
 const SceneCase kSceneCases[] = {
-    {"simulated_interpolation", [](EventModel) { return testing::SimulatedInterpolation(); }, true,
+    {"simulated_interpolation", [](EventModel) { return test::SimulatedInterpolation(); }, true,
      kMargin, kMargin},
-    {"simulated_prediction", testing::SimulatedPrediction, true, kMargin, kMargin},
-    {"simulated_deblur", testing::SimulatedDeblur, true, kMargin, kMargin},
-    {"all_black", testing::AllBlack, false, kMargin, kMargin},
-    {"all_white", testing::AllWhite, false, kMargin, kMargin},
-    {"constant", testing::Constant, false, kMargin, kMargin},
-    {"one_latent_frame", testing::OneLatentFrame, false, kMargin, kMargin},
-    {"black_start_prediction", testing::BlackStartPrediction, true, kMargin, kMargin},
-    {"white_start_prediction", testing::WhiteStartPrediction, true, kMargin, kMargin},
-    {"saturated_interpolation", testing::SaturatedScene, true, kMargin, kMargin},
-    {"black_start_deblur", testing::BlackStartDeblur, true, kMargin, kMargin},
-    {"saturated_deblur", testing::SaturatedDeblur, true, kMargin, kMargin},
-    {"single_row", testing::SingleRow, true, kMargin, kMargin},
-    {"every_pixel_every_step", testing::EveryPixelEveryStep, true, kNotOptimum, kNotOptimum},
-    {"500_latent_frames", testing::FiveHundredLatentFrames, true, kMargin, kNotOptimum},
-    {"contradictory_event_frames", testing::ContradictoryEventFrames, true, kMargin, kMargin},
-    {"contradictory_stacked_events", testing::ContradictoryStackedEvents, true, kMargin, kMargin},
-    {"events_disagree_with_frames", testing::EventsDisagreeWithFrames, true, kNotOptimum,
-     kNotOptimum},
+    {"simulated_prediction", test::SimulatedPrediction, true, kMargin, kMargin},
+    {"simulated_deblur", test::SimulatedDeblur, true, kMargin, kMargin},
+    {"all_black", test::AllBlack, false, kMargin, kMargin},
+    {"all_white", test::AllWhite, false, kMargin, kMargin},
+    {"constant", test::Constant, false, kMargin, kMargin},
+    {"one_latent_frame", test::OneLatentFrame, false, kMargin, kMargin},
+    {"black_start_prediction", test::BlackStartPrediction, true, kMargin, kMargin},
+    {"white_start_prediction", test::WhiteStartPrediction, true, kMargin, kMargin},
+    {"saturated_interpolation", test::SaturatedScene, true, kMargin, kMargin},
+    {"black_start_deblur", test::BlackStartDeblur, true, kMargin, kMargin},
+    {"saturated_deblur", test::SaturatedDeblur, true, kMargin, kMargin},
+    {"single_row", test::SingleRow, true, kMargin, kMargin},
+    {"every_pixel_every_step", test::EveryPixelEveryStep, true, kNotOptimum, kNotOptimum},
+    {"500_latent_frames", test::FiveHundredLatentFrames, true, kMargin, kNotOptimum},
+    {"contradictory_event_frames", test::ContradictoryEventFrames, true, kMargin, kMargin},
+    {"contradictory_stacked_events", test::ContradictoryStackedEvents, true, kMargin, kMargin},
+    {"events_disagree_with_frames", test::EventsDisagreeWithFrames, true, kNotOptimum, kNotOptimum},
 };
 
 std::string CaseName(const SceneCase& scene_case, EventModel model) {
@@ -81,7 +80,7 @@ TEST_P(SceneStress, ReconstructionStaysFiniteAndDoesNotDegrade) {
   const StressScene stress = scene_case.make(model);
   ReconstructionOptions options;
   options.objective.event_model.model = model;
-  const Reconstruction result = testing::ExpectStableReconstruction(
+  const Reconstruction result = test::ExpectStableReconstruction(
       stress, options, model == EventModel::kLinear ? scene_case.psnr_linear : scene_case.psnr_log,
       CaseName(scene_case, model));
   EXPECT_EQ(result.summary.solved, scene_case.solves);
@@ -113,9 +112,9 @@ TEST_P(SceneStress, BaselinesStayFiniteOrRefuse) {
       }
       const BaselineResult result = RunBaseline(method, stress.scene, options);
       ASSERT_EQ(result.video.num_frames(), stress.scene.num_latent_frames());
-      EXPECT_TRUE(testing::AllFinite(result.video)) << "the baseline's video holds NaN or Inf";
+      EXPECT_TRUE(test::AllFinite(result.video)) << "the baseline's video holds NaN or Inf";
       if (clamp) {
-        EXPECT_TRUE(testing::WithinUnitRange(result.video));
+        EXPECT_TRUE(test::WithinUnitRange(result.video));
       }
       for (const BaselineParameter& parameter : result.parameters) {
         EXPECT_TRUE(std::isfinite(parameter.value)) << parameter.name;
@@ -129,7 +128,7 @@ TEST(LogModelAtZero, BlackFirstFrameBrightensWhereEventsFire) {
   // Regression: g'(0) of the log model was 0, so a bounded solve from a black frame had no
   // event gradient anywhere and Ceres stopped after 0 iterations with the black copy (17.38 dB;
   // 18.21 dB since g'(0) = 1/b). The square the events bring in must appear.
-  const StressScene stress = testing::BlackStartPrediction(EventModel::kLog);
+  const StressScene stress = test::BlackStartPrediction(EventModel::kLog);
   ReconstructionOptions options;
   options.objective.event_model.model = EventModel::kLog;
   const Reconstruction result = Reconstruct(stress.scene, options);

@@ -17,8 +17,8 @@
 namespace evfs {
 namespace {
 
-using testing::PsnrCheck;
-using testing::StressScene;
+using test::PsnrCheck;
+using test::StressScene;
 
 // A scene of the sweeps and the event model it is solved with.
 struct SolverScene {
@@ -27,14 +27,13 @@ struct SolverScene {
   EventModel model;
 };
 
-const SolverScene kTinyScene = {"tiny_moving_square", testing::TinyMovingSquare,
-                                EventModel::kLinear};
+const SolverScene kTinyScene = {"tiny_moving_square", test::TinyMovingSquare, EventModel::kLinear};
 const SolverScene kSolverScenes[] = {
     kTinyScene,
-    {"simulated_interpolation", [](EventModel) { return testing::SimulatedInterpolation(); },
+    {"simulated_interpolation", [](EventModel) { return test::SimulatedInterpolation(); },
      EventModel::kLinear},
-    {"black_start_prediction_log", testing::BlackStartPrediction, EventModel::kLog},
-    {"saturated_interpolation_log", testing::SaturatedScene, EventModel::kLog},
+    {"black_start_prediction_log", test::BlackStartPrediction, EventModel::kLog},
+    {"saturated_interpolation_log", test::SaturatedScene, EventModel::kLog},
 };
 
 // A Ceres configuration; the rest is DefaultSolverOptions.
@@ -93,9 +92,9 @@ TEST_P(CeresStress, StaysFiniteAndDoesNotDegrade) {
   ReconstructionOptions options;
   options.objective.event_model.model = solver_scene.model;
   Configure(ceres_case, &options);
-  testing::ExpectStableReconstruction(solver_scene.make(solver_scene.model), options,
-                                      PsnrCheck::kWithinMargin,
-                                      std::string(ceres_case.name) + " " + solver_scene.name);
+  test::ExpectStableReconstruction(solver_scene.make(solver_scene.model), options,
+                                   PsnrCheck::kWithinMargin,
+                                   std::string(ceres_case.name) + " " + solver_scene.name);
 }
 
 std::string CeresCaseName(
@@ -197,9 +196,9 @@ TEST_P(FirstOrderStress, StaysFiniteAndDoesNotDegrade) {
   // finiteness and the bounds are asserted for Adam at that α. The log model with b = 1e-6 is
   // the same staircase near black: g' = 1/b = 1e6 at 0 (measured 0.16 → 0.86 from a black
   // first frame, while the PSNR still rose 17.38 → 17.59 dB).
-  const bool stiff_model = objective.event_model.alpha >= 1000.0 ||
-                           (objective.event_model.model == EventModel::kLog &&
-                            objective.event_model.log_offset <= 1e-6);
+  const bool stiff_model =
+      objective.event_model.alpha >= 1000.0 ||
+      (objective.event_model.model == EventModel::kLog && objective.event_model.log_offset <= 1e-6);
   const bool adam_may_climb = !solver.lbfgs && stiff_model;
   if (!adam_may_climb) {
     EXPECT_LE(summary.final_cost, summary.initial_cost) << label;
@@ -208,13 +207,13 @@ TEST_P(FirstOrderStress, StaysFiniteAndDoesNotDegrade) {
   const double cost =
       FusedObjective(stress.scene, objective, mask, fused_options).Evaluate(latent, &gradient);
   EXPECT_TRUE(std::isfinite(cost)) << label;
-  EXPECT_NEAR(summary.final_cost, cost, testing::kCostTolerance * cost)
+  EXPECT_NEAR(summary.final_cost, cost, test::kCostTolerance * cost)
       << label << ": the reported cost is not the cost of the returned video";
-  EXPECT_TRUE(testing::AllFinite(gradient)) << label << ": the gradient holds NaN or Inf";
+  EXPECT_TRUE(test::AllFinite(gradient)) << label << ": the gradient holds NaN or Inf";
   // L-BFGS is unbounded (LbfgsOptions): its result is only required to be finite.
-  testing::ExpectSaneVideo(latent, initial, stress.truth, /*bounded=*/!solver.lbfgs,
-                           adam_may_climb ? PsnrCheck::kNone : PsnrCheck::kWithinMargin,
-                           label + " (" + summary.termination + ")");
+  test::ExpectSaneVideo(latent, initial, stress.truth, /*bounded=*/!solver.lbfgs,
+                        adam_may_climb ? PsnrCheck::kNone : PsnrCheck::kWithinMargin,
+                        label + " (" + summary.termination + ")");
 }
 
 INSTANTIATE_TEST_SUITE_P(ScenesAndExtremes, FirstOrderStress,

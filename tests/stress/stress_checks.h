@@ -23,7 +23,7 @@
 #include "tests/stress/stress_scenes.h"
 
 namespace evfs {
-namespace testing {
+namespace test {
 
 /// PSNR is capped here: 60 dB is an RMS error of 1e-3, a quarter of an 8-bit grey level, below
 /// which two results are the same picture; without the cap an initialisation equal to the truth
@@ -196,7 +196,7 @@ inline Reconstruction ExpectStableReconstruction(const StressScene& stress,
   return result;
 }
 
-}  // namespace testing
+}  // namespace test
 }  // namespace evfs
 
 #endif  // EVFS_TESTS_STRESS_STRESS_CHECKS_H_

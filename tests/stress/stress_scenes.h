@@ -14,13 +14,13 @@
 
 #include "core/event_stream.h"
 #include "core/video.h"
-#include "scene/event_model.h"
 #include "events/random.h"
+#include "scene/event_model.h"
 #include "scene/scene.h"
 #include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
-namespace testing {
+namespace test {
 
 /// A scene and the truth on its latent timeline.
 struct StressScene {
@@ -324,7 +324,7 @@ inline StressScene EventsDisagreeWithFrames(EventModel sensor) {
   return stress;
 }
 
-}  // namespace testing
+}  // namespace test
 }  // namespace evfs
 
 #endif  // EVFS_TESTS_STRESS_STRESS_SCENES_H_
