@@ -7,13 +7,16 @@
 namespace evfs {
 
 const char* InitializationName(Initialization initialization) {
-  return initialization == Initialization::kBlend ? "blend" : "events";
+  return NameOf(kInitializationNames, initialization);
 }
 
 Initialization ParseInitialization(const std::string& name) {
-  if (name == "blend") return Initialization::kBlend;
-  if (name == "events") return Initialization::kEvents;
-  throw InvalidArgumentError("unknown initialisation '" + name + "' (blend or events)");
+  Initialization initialization = Initialization::kBlend;
+  if (!FindName(kInitializationNames, name, &initialization)) {
+    throw InvalidArgumentError("unknown initialisation '" + name + "' (" +
+                               NameList(kInitializationNames, ", ", " or ") + ")");
+  }
+  return initialization;
 }
 
 Video InitialLatentVideo(const Scene& scene, Initialization initialization,

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "baselines/baseline_options.h"
+#include "core/enum_names.h"
 #include "core/video.h"
 #include "scene/scene.h"
 
@@ -15,6 +16,11 @@ namespace evfs {
 enum class Initialization {
   kBlend,   ///< the frames blended linearly in time (a copy when there is one)
   kEvents,  ///< integrate when the scene has a sharp frame, else edi, else the blend
+};
+
+inline constexpr EnumName<Initialization> kInitializationNames[] = {
+    {Initialization::kBlend, "blend", "the frames blended linearly in time"},
+    {Initialization::kEvents, "events", "integrate from a sharp frame, else edi, else blend"},
 };
 
 /// "blend", "events".

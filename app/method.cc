@@ -1,5 +1,7 @@
 #include "app/method.h"
 
+#include <glog/logging.h>
+
 #include <chrono>
 
 #include "baselines/baseline.h"
@@ -14,24 +16,28 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-struct MethodInfo {
-  Method method;
-  const char* name;
-};
-
-constexpr MethodInfo kMethods[] = {
-    {Method::kCeresLm, "ceres_lm"},
-    {Method::kCeresLbfgs, "ceres_lbfgs"},
-    {Method::kAdam, "adam"},
-    {Method::kAdamSmooth, "adam_smooth"},
-    {Method::kBlend, "blend"},
-    {Method::kCopy, "copy"},
-    {Method::kIntegrate, "integrate"},
-    {Method::kComplementaryFilter, "cf"},
-    {Method::kEdi, "edi"},
-};
-
-BaselineMethod AsBaseline(Method method) { return ParseBaseline(MethodName(method)); }
+// The baseline a classical method runs; only called for those (IsIterative is false).
+BaselineMethod AsBaseline(Method method) {
+  switch (method) {
+    case Method::kBlend:
+      return BaselineMethod::kBlend;
+    case Method::kCopy:
+      return BaselineMethod::kCopy;
+    case Method::kIntegrate:
+      return BaselineMethod::kIntegrate;
+    case Method::kComplementaryFilter:
+      return BaselineMethod::kComplementaryFilter;
+    case Method::kEdi:
+      return BaselineMethod::kEdi;
+    case Method::kCeresLm:
+    case Method::kCeresLbfgs:
+    case Method::kAdam:
+    case Method::kAdamSmooth:
+      break;
+  }
+  LOG(FATAL) << MethodName(method) << " is not a baseline";
+  return BaselineMethod::kBlend;
+}
 
 // Wraps the caller's progress callback, recording a checkpoint per iteration when asked.
 IterationCallback Observer(const IterationCallback& progress, bool record_checkpoints,
@@ -112,28 +118,18 @@ void RunFirstOrder(const Scene& scene, const MethodOptions& options, const Video
 
 }  // namespace
 
-const char* MethodName(Method method) {
-  for (const MethodInfo& info : kMethods) {
-    if (info.method == method) return info.name;
-  }
-  return "unknown";
-}
+const char* MethodName(Method method) { return NameOf(kMethodNames, method, "unknown"); }
 
 Method ParseMethod(const std::string& name) {
-  std::string names;
-  for (const MethodInfo& info : kMethods) {
-    if (name == info.name) return info.method;
-    names += names.empty() ? "" : ", ";
-    names += info.name;
+  Method method = Method::kCeresLm;
+  if (!FindName(kMethodNames, name, &method)) {
+    throw InvalidArgumentError("unknown method '" + name + "' (one of " + NameList(kMethodNames) +
+                               ")");
   }
-  throw InvalidArgumentError("unknown method '" + name + "' (one of " + names + ")");
+  return method;
 }
 
-std::vector<Method> AllMethods() {
-  std::vector<Method> methods;
-  for (const MethodInfo& info : kMethods) methods.push_back(info.method);
-  return methods;
-}
+std::vector<Method> AllMethods() { return AllValues(kMethodNames); }
 
 bool IsIterative(Method method) {
   return method == Method::kCeresLm || method == Method::kCeresLbfgs || method == Method::kAdam ||

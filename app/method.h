@@ -15,6 +15,7 @@
 #include "app/initialization.h"
 #include "baselines/baseline.h"
 #include "baselines/baseline_options.h"
+#include "core/enum_names.h"
 #include "core/video.h"
 #include "scene/scene.h"
 #include "solver/first_order_solvers.h"
@@ -34,6 +35,19 @@ enum class Method {
   kIntegrate,
   kComplementaryFilter,
   kEdi,
+};
+
+/// The methods' names, in the order above.
+inline constexpr EnumName<Method> kMethodNames[] = {
+    {Method::kCeresLm, "ceres_lm", "Levenberg-Marquardt on the Ceres residual-block problem"},
+    {Method::kCeresLbfgs, "ceres_lbfgs", "Ceres' L-BFGS on the fused smoothed objective"},
+    {Method::kAdam, "adam", "the paper's Adam schedule on the true-l1 objective"},
+    {Method::kAdamSmooth, "adam_smooth", "the same schedule on the smoothed objective"},
+    {Method::kBlend, "blend", "baseline: the frames blended linearly in time"},
+    {Method::kCopy, "copy", "baseline: the one frame copied"},
+    {Method::kIntegrate, "integrate", "baseline: events integrated from a sharp frame"},
+    {Method::kComplementaryFilter, "cf", "baseline: complementary filter"},
+    {Method::kEdi, "edi", "baseline: Event-based Double Integral"},
 };
 
 /// "ceres_lm", "ceres_lbfgs", "adam", "adam_smooth", "blend", "copy", "integrate", "cf", "edi".

@@ -85,24 +85,15 @@ Video Resample(const Video& latent, double fps) {
 }  // namespace
 
 Mode ParseMode(const std::string& name) {
-  if (name == "interpolate") return Mode::kInterpolate;
-  if (name == "predict") return Mode::kPredict;
-  if (name == "deblur") return Mode::kDeblur;
-  throw InvalidArgumentError("unknown mode '" + name +
-                             "': expected interpolate, predict or deblur");
+  Mode mode = Mode::kPredict;
+  if (!FindName(kModeNames, name, &mode)) {
+    throw InvalidArgumentError("unknown mode '" + name + "': expected " +
+                               NameList(kModeNames, ", ", " or "));
+  }
+  return mode;
 }
 
-const char* ModeName(Mode mode) {
-  switch (mode) {
-    case Mode::kInterpolate:
-      return "interpolate";
-    case Mode::kPredict:
-      return "predict";
-    case Mode::kDeblur:
-      return "deblur";
-  }
-  return "";
-}
+const char* ModeName(Mode mode) { return NameOf(kModeNames, mode); }
 
 ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   const auto total_start = Clock::now();

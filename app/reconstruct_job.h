@@ -9,12 +9,19 @@
 #include <string>
 
 #include "app/method.h"
+#include "core/enum_names.h"
 #include "core/video.h"
 #include "scene/scene.h"
 
 namespace evfs {
 
 enum class Mode { kInterpolate, kPredict, kDeblur };
+
+inline constexpr EnumName<Mode> kModeNames[] = {
+    {Mode::kInterpolate, "interpolate", "frames between two inputs"},
+    {Mode::kPredict, "predict", "frames after one sharp input"},
+    {Mode::kDeblur, "deblur", "sharp frames inside one blurred exposure"},
+};
 
 /// "interpolate", "predict", "deblur" → Mode; throws InvalidArgumentError otherwise.
 Mode ParseMode(const std::string& name);

@@ -15,10 +15,6 @@
 namespace evfs {
 namespace {
 
-constexpr BaselineMethod kMethods[] = {BaselineMethod::kBlend, BaselineMethod::kCopy,
-                                       BaselineMethod::kIntegrate,
-                                       BaselineMethod::kComplementaryFilter, BaselineMethod::kEdi};
-
 bool HasThreshold(BaselineMethod method) {
   return method == BaselineMethod::kIntegrate || method == BaselineMethod::kComplementaryFilter ||
          method == BaselineMethod::kEdi;
@@ -101,30 +97,15 @@ void CheckRunnable(BaselineMethod method, const Scene& scene, const BaselineOpti
 
 }  // namespace
 
-const char* BaselineName(BaselineMethod method) {
-  switch (method) {
-    case BaselineMethod::kBlend:
-      return "blend";
-    case BaselineMethod::kCopy:
-      return "copy";
-    case BaselineMethod::kIntegrate:
-      return "integrate";
-    case BaselineMethod::kComplementaryFilter:
-      return "cf";
-    case BaselineMethod::kEdi:
-      return "edi";
-  }
-  return "";
-}
+const char* BaselineName(BaselineMethod method) { return NameOf(kBaselineNames, method); }
 
 BaselineMethod ParseBaseline(const std::string& name) {
-  std::string names;
-  for (BaselineMethod method : kMethods) {
-    if (name == BaselineName(method)) return method;
-    names += names.empty() ? "" : ", ";
-    names += BaselineName(method);
+  BaselineMethod method = BaselineMethod::kBlend;
+  if (!FindName(kBaselineNames, name, &method)) {
+    throw InvalidArgumentError("unknown baseline '" + name + "': expected one of " +
+                               NameList(kBaselineNames));
   }
-  throw InvalidArgumentError("unknown baseline '" + name + "': expected one of " + names);
+  return method;
 }
 
 bool BaselineSupports(BaselineMethod method, const Scene& scene, std::string* why_not) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "baselines/baseline_options.h"
+#include "core/enum_names.h"
 #include "core/video.h"
 #include "scene/scene.h"
 
@@ -44,6 +45,15 @@ struct BaselineResult {
   /// How the contrast threshold was chosen, one line ("given", "measured between the frames
   /// …", "EDI sharpness criterion …", "tuned on the truth frame …"); empty for blend and copy.
   std::string threshold_source;
+};
+
+/// The baselines' names, in the order above.
+inline constexpr EnumName<BaselineMethod> kBaselineNames[] = {
+    {BaselineMethod::kBlend, "blend", "the frames blended linearly in time"},
+    {BaselineMethod::kCopy, "copy", "the one frame copied to every latent frame"},
+    {BaselineMethod::kIntegrate, "integrate", "events integrated from a sharp frame"},
+    {BaselineMethod::kComplementaryFilter, "cf", "complementary filter of frames and events"},
+    {BaselineMethod::kEdi, "edi", "Event-based Double Integral of a blurred frame"},
 };
 
 /// "blend", "copy", "integrate", "cf", "edi".

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "events/option_checker.h"
+#include "core/option_checker.h"
 
 namespace evfs {
 
@@ -18,8 +18,9 @@ bool BaselineOptions::IsValid(std::string* error) const {
       .Require(std::isfinite(threshold_search_max) && threshold_search_max > threshold_search_min,
                "threshold_search_max", "finite and > threshold_search_min")
       .NonNegative("edi_tv_weight", edi_tv_weight)
-      .Require(edi_edge_window > 0.0 && edi_edge_window <= 1.0, "edi_edge_window", "in (0, 1]");
-  return check.Passed(error) && estimation.IsValid(error);
+      .Require(edi_edge_window > 0.0 && edi_edge_window <= 1.0, "edi_edge_window", "in (0, 1]")
+      .Valid(estimation);
+  return check.Passed(error);
 }
 
 void CheckContrastThreshold(double contrast_threshold, const char* method) {

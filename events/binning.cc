@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "events/option_checker.h"
+#include "core/option_checker.h"
 
 namespace evfs {
 namespace {

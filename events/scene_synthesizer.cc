@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/option_checker.h"
 #include "core/time.h"
-#include "events/option_checker.h"
 #include "events/random.h"
 
 namespace evfs {

@@ -6,8 +6,8 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/option_checker.h"
 #include "core/time.h"
-#include "events/option_checker.h"
 
 namespace evfs {
 namespace {

@@ -27,6 +27,7 @@
 #include "app/demo.h"
 #include "app/progress.h"
 #include "app/reconstruct_job.h"
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/time.h"
 #include "events/binning.h"
@@ -216,15 +217,7 @@ OutputOptions OutputFromFlags(const std::string& command, const std::string& inp
 // The binning flags (reconstruct, and info's window).
 BinningOptions BinningFromFlags() {
   BinningOptions binning;
-  if (FLAGS_binning == "auto") {
-    binning.method = BinningOptions::Method::kAuto;
-  } else if (FLAGS_binning == "collision") {
-    binning.method = BinningOptions::Method::kCollision;
-  } else if (FLAGS_binning == "stacked") {
-    binning.method = BinningOptions::Method::kStacked;
-  } else {
-    throw InvalidArgumentError("--binning must be auto, collision or stacked");
-  }
+  binning.method = ParseName(kBinningMethodNames, FLAGS_binning, "--binning");
   binning.max_latent_frames = FLAGS_max_latent_frames;
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
@@ -254,10 +247,10 @@ void PrintWindow(const DataSource& source, int first, int last) {
       window.size() - positive, static_cast<long long>(activity.pixels_fired),
       100.0 * static_cast<double>(activity.pixels_fired) / static_cast<double>(plan.pixels),
       static_cast<long long>(plan.collision_frames), hot.c_str());
-  const bool collision = plan.method == BinningOptions::Method::kCollision;
   std::printf("binning     %s: %s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
-              FLAGS_binning.c_str(), collision ? "collision" : "stacked", plan.num_event_frames,
-              plan.num_latent_frames, static_cast<long long>(plan.latent_voxels()),
+              FLAGS_binning.c_str(), NameOf(kBinningMethodNames, plan.method),
+              plan.num_event_frames, plan.num_latent_frames,
+              static_cast<long long>(plan.latent_voxels()),
               static_cast<long long>(FLAGS_max_latent_voxels));
   // A change of overall brightness between the frames (flicker, exposure or gain) that no
   // event records is outside the per-pixel event model; this line shows it.
@@ -426,10 +419,8 @@ ReconstructRequest RequestFromFlags() {
   objective.event_model.alpha = FLAGS_alpha;
   objective.event_model.log_offset = FLAGS_log_offset;
   objective.smoothing_scale = FLAGS_smoothing_scale;
-  Require(ParseEventModel(FLAGS_event_model, &objective.event_model.model),
-          "--event_model must be linear or log");
-  Require(ParseSpatialTv(FLAGS_spatial_tv, &objective.spatial_tv),
-          "--spatial_tv must be paper, anisotropic or isotropic");
+  objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
+  objective.spatial_tv = ParseName(kSpatialTvNames, FLAGS_spatial_tv, "--spatial_tv");
   options.bound_intensities = FLAGS_bounds;
   options.activity_radius_px = FLAGS_activity_radius_px;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;

@@ -22,6 +22,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/option_checker.h"
 #include "io/aedat4/events_generated.h"
 #include "io/aedat4/file_data_table_generated.h"
 #include "io/aedat4/frame_generated.h"
@@ -493,11 +494,10 @@ const char* Aedat4CompressionName(Aedat4Compression compression) {
 
 bool Aedat4WriteOptions::IsValid(std::string* error) const {
   constexpr int kMaxEventsPerPacket = 1 << 20;  // 16 MB decompressed, within kMaxPacketBytes
-  if (max_events_per_packet < 1 || max_events_per_packet > kMaxEventsPerPacket) {
-    *error = "max_events_per_packet must be in [1, " + std::to_string(kMaxEventsPerPacket) + "]";
-    return false;
-  }
-  return true;
+  OptionChecker check;
+  check.Require(max_events_per_packet >= 1 && max_events_per_packet <= kMaxEventsPerPacket,
+                "max_events_per_packet", "in [1, " + std::to_string(kMaxEventsPerPacket) + "]");
+  return check.Passed(error);
 }
 
 bool IsAedat4Path(const std::string& path) {

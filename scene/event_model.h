@@ -11,12 +11,21 @@
 #include <cmath>
 #include <string>
 
+#include "core/enum_names.h"
+#include "core/option_checker.h"
+
 namespace evfs {
 
 /// Which intensity transform g the event model compares between latent frames.
 enum class EventModel {
   kLinear,  ///< g(x) = x   (paper Eq. 2)
   kLog,     ///< g(x) = log(x + b)   (paper Eq. 1)
+};
+
+/// Names used by flags and summaries.
+inline constexpr EnumName<EventModel> kEventModelNames[] = {
+    {EventModel::kLinear, "linear", "g(x) = x, paper Eq. 2"},
+    {EventModel::kLog, "log", "g(x) = log(x + b), paper Eq. 1"},
 };
 
 /// Parameters of the event model.
@@ -28,14 +37,14 @@ struct EventModelParams {
   /// True when alpha > 0 and, for kLog, log_offset > 0; otherwise false with the reason in
   /// `*error` (when not null).
   bool IsValid(std::string* error) const {
-    std::string reason;
+    OptionChecker check;
     if (!(alpha > 0.0)) {
-      reason = "event model alpha must be > 0, got " + std::to_string(alpha);
-    } else if (model == EventModel::kLog && !(log_offset > 0.0)) {
-      reason = "log event model offset b must be > 0, got " + std::to_string(log_offset);
+      check.Check(false, "event model alpha must be > 0, got " + std::to_string(alpha));
     }
-    if (error != nullptr) *error = reason;
-    return reason.empty();
+    if (model == EventModel::kLog && !(log_offset > 0.0)) {
+      check.Check(false, "log event model offset b must be > 0, got " + std::to_string(log_offset));
+    }
+    return check.Passed(error);
   }
 };
 

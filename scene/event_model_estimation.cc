@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/option_checker.h"
+
 namespace evfs {
 namespace {
 
@@ -30,12 +32,11 @@ std::vector<double> NetEventCount(const Scene& scene, int first, int last) {
 }  // namespace
 
 bool EventModelEstimationOptions::IsValid(std::string* error) const {
-  if (!(alpha_times_change > 0.0) || !(assumed_contrast_threshold > 0.0) ||
-      !(assumed_linear_change > 0.0) || min_pixels < 1) {
-    if (error) *error = "event model estimation options must be positive";
-    return false;
-  }
-  return true;
+  OptionChecker check;
+  check.Check(alpha_times_change > 0.0 && assumed_contrast_threshold > 0.0 &&
+                  assumed_linear_change > 0.0 && min_pixels >= 1,
+              "event model estimation options must be positive");
+  return check.Passed(error);
 }
 
 EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams& model,

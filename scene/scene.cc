@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/option_checker.h"
 
 namespace evfs {
 namespace {
@@ -98,15 +99,13 @@ int NearestLatent(const std::vector<int64_t>& latent_ns, int64_t t_ns) {
 }  // namespace
 
 bool BinningOptions::IsValid(std::string* error) const {
-  if (max_latent_frames < 1 || max_latent_voxels < 1) {
-    *error = "max_latent_frames and max_latent_voxels must be at least 1";
-    return false;
-  }
-  if (!(hot_pixel_factor >= 0.0 && std::isfinite(hot_pixel_factor))) {
-    *error = "hot_pixel_factor must be finite and >= 0";
-    return false;
-  }
-  return method != Method::kStacked || stacked.IsValid(error);
+  OptionChecker check;
+  check
+      .Check(max_latent_frames >= 1 && max_latent_voxels >= 1,
+             "max_latent_frames and max_latent_voxels must be at least 1")
+      .NonNegative("hot_pixel_factor", hot_pixel_factor);
+  if (method == Method::kStacked) check.Valid(stacked);
+  return check.Passed(error);
 }
 
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/event_frames.h"
 #include "core/event_stream.h"
 #include "core/video.h"
@@ -60,6 +61,13 @@ struct BinningOptions {
   StackedBinningOptions stacked;  // used by kStacked
 
   bool IsValid(std::string* error) const;
+};
+
+/// --binning's names.
+inline constexpr EnumName<BinningOptions::Method> kBinningMethodNames[] = {
+    {BinningOptions::Method::kAuto, "auto", "collision binning unless it exceeds the limits"},
+    {BinningOptions::Method::kCollision, "collision", "one step per collision frame"},
+    {BinningOptions::Method::kStacked, "stacked", "stacked equal-time or equal-count frames"},
 };
 
 /// What binning a window gets, decided from counts alone (no frame is allocated).

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/option_checker.h"
 #include "core/time.h"
 
 namespace evfs {
@@ -131,22 +132,16 @@ class LbfgsCallback : public ceres::IterationCallback {
 }  // namespace
 
 bool AdamOptions::IsValid(std::string* error) const {
-  const auto fail = [error](const std::string& reason) {
-    *error = reason;
-    return false;
-  };
-  if (max_iterations < 0) return fail("max_iterations must be >= 0");
-  if (!(std::isfinite(learning_rate) && learning_rate > 0.0)) {
-    return fail("learning_rate must be positive");
-  }
-  if (decay_every < 1) return fail("decay_every must be at least 1");
-  if (!(decay_factor > 0.0 && decay_factor <= 1.0)) return fail("decay_factor must be in (0, 1]");
-  if (!(beta1 >= 0.0 && beta1 < 1.0) || !(beta2 >= 0.0 && beta2 < 1.0)) {
-    return fail("beta1 and beta2 must be in [0, 1)");
-  }
-  if (!(std::isfinite(epsilon) && epsilon > 0.0)) return fail("epsilon must be positive");
-  if (num_threads < 1) return fail("num_threads must be at least 1");
-  return true;
+  OptionChecker check;
+  check.Require(max_iterations >= 0, "max_iterations", ">= 0")
+      .Require(std::isfinite(learning_rate) && learning_rate > 0.0, "learning_rate", "positive")
+      .Require(decay_every >= 1, "decay_every", "at least 1")
+      .Require(decay_factor > 0.0 && decay_factor <= 1.0, "decay_factor", "in (0, 1]")
+      .Require(beta1 >= 0.0 && beta1 < 1.0 && beta2 >= 0.0 && beta2 < 1.0, "beta1 and beta2",
+               "in [0, 1)")
+      .Require(std::isfinite(epsilon) && epsilon > 0.0, "epsilon", "positive")
+      .Require(num_threads >= 1, "num_threads", "at least 1");
+  return check.Passed(error);
 }
 
 double AdamOptions::LearningRate(int iteration) const {
@@ -166,15 +161,12 @@ ceres::GradientProblemSolver::Options DefaultLbfgsSolverOptions() {
 LbfgsOptions::LbfgsOptions() : solver(DefaultLbfgsSolverOptions()) {}
 
 bool LbfgsOptions::IsValid(std::string* error) const {
-  if (num_threads < 1) {
-    *error = "num_threads must be at least 1";
-    return false;
-  }
-  if (solver.line_search_direction_type == ceres::BFGS) {
-    *error = "dense BFGS needs n² memory for n unknowns: use LBFGS";
-    return false;
-  }
-  return solver.IsValid(error);
+  OptionChecker check;
+  check.Require(num_threads >= 1, "num_threads", "at least 1")
+      .Check(solver.line_search_direction_type != ceres::BFGS,
+             "dense BFGS needs n² memory for n unknowns: use LBFGS")
+      .Valid(solver);
+  return check.Passed(error);
 }
 
 FirstOrderSummary SolveWithAdam(const Scene& scene, const ObjectiveOptions& objective_options,

@@ -5,8 +5,10 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "core/option_checker.h"
 #include "cost_functions/weighted_l1_loss.h"
 #include "scene/event_model.h"
+#include "solver/objective_terms.h"
 
 namespace evfs {
 namespace {
@@ -101,11 +103,7 @@ const char* L1PenaltyName(L1Penalty penalty) {
 }
 
 bool FusedObjectiveOptions::IsValid(std::string* error) const {
-  if (num_threads < 1) {
-    *error = "num_threads must be at least 1, got " + std::to_string(num_threads);
-    return false;
-  }
-  return true;
+  return OptionChecker().InRange("num_threads", num_threads, 1, 1 << 16).Passed(error);
 }
 
 // Layout of an evaluation. The rows of the image are split into bands of about equal work, a few
@@ -177,7 +175,7 @@ struct FusedObjective::Impl {
   FusedObjectiveOptions options;
   int height = 0, width = 0, num_latent = 0;
   int64_t pixels = 0;
-  // Weight of each family divided by its term count normalisation; 0 leaves the family out.
+  // Normalised weight of each family's terms (ObjectiveTerms); 0 leaves the family out.
   double frame_weight = 0.0, event_weight = 0.0, spatial_weight = 0.0, temporal_weight = 0.0;
   double eps = 0.0;
   EventModelParams event_model;
@@ -217,12 +215,11 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
   eps = objective.smoothing_scale;
   event_model = objective.event_model;
   spatial_tv = objective.spatial_tv;
-  const double hw = static_cast<double>(pixels);
-  // The normalisations of ProblemBuilder's losses (ObjectiveOptions).
-  frame_weight = objective.frame_weight / hw;
-  event_weight = objective.event_weight / hw;
-  spatial_weight = objective.spatial_tv_weight / num_latent / hw;
-  temporal_weight = num_latent > 1 ? objective.temporal_tv_weight / hw : 0.0;
+  const ObjectiveTerms terms(scene, objective, mask);
+  frame_weight = terms.weight(TermFamily::kFrame);
+  event_weight = terms.weight(TermFamily::kEvent);
+  spatial_weight = terms.weight(TermFamily::kSpatialTv);
+  temporal_weight = terms.weight(TermFamily::kTemporalTv);
 
   if (frame_weight > 0.0) {
     for (const FrameObservation& frame : scene.frames) {
@@ -263,7 +260,6 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
   }
 
   if (spatial_weight > 0.0) {
-    // A term exists when any pixel it touches is active (ProblemBuilder).
     mask_right.assign(pixels, 0.0);
     mask_below.assign(pixels, 0.0);
     const bool anisotropic = spatial_tv == SpatialTv::kAnisotropic;
@@ -276,16 +272,11 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
       };
       for (int x = 0; x < width; ++x) {
         const int64_t p = static_cast<int64_t>(y) * width + x;
-        const bool has_right = x + 1 < width, has_below = y + 1 < height;
+        const SpatialTvTermsAt owned = terms.spatial_tv_terms_at(p);
+        mask_right[p] = owned.right;
+        mask_below[p] = anisotropic ? owned.below : owned.right;
         const bool here = mask.active(p);
-        const bool right = has_right && mask.active(p + 1);
-        const bool below = has_below && mask.active(p + width);
-        if (anisotropic) {
-          mask_right[p] = has_right && (here || right);
-          mask_below[p] = has_below && (here || below);
-        } else {
-          mask_right[p] = mask_below[p] = has_right && has_below && (here || right || below);
-        }
+        const bool below = y + 1 < height && mask.active(p + width);
         if (mask_right[p] > 0.0 || mask_below[p] > 0.0 || below) need(x);
         if (here) {
           need(x);

@@ -10,10 +10,9 @@
 // with Δg_s = g(H_{s+1}(p)) − g(H_s(p)), c = SaturationForCount(E_k(p), b_k − a_k)
 // (event_model.h), N latent frames, and ρ either the smoothed ℓ1 sqrt(ε² + r²) − ε that the
 // Ceres problem minimises (CreateWeightedL1Loss) or the paper's true ℓ1 |r|. For isotropic TV, r is
-// the forward-difference gradient (∂x H, ∂y H) and ρ applies to its norm. As in ProblemBuilder, the
-// frame, event and temporal terms are summed over active pixels only, a spatial TV term is
-// present when any pixel it touches is active, zero-weight families are left out, and only
-// active voxels are unknowns (ActivityMask): the gradient of ring and inactive voxels is 0.
+// the forward-difference gradient (∂x H, ∂y H) and ρ applies to its norm. Which terms exist and
+// their weights are ObjectiveTerms', which ProblemBuilder follows too. Only active voxels are
+// unknowns (ActivityMask): the gradient of ring and inactive voxels is 0.
 #ifndef EVFS_SOLVER_FUSED_OBJECTIVE_H_
 #define EVFS_SOLVER_FUSED_OBJECTIVE_H_
 

@@ -13,6 +13,7 @@
 #include "cost_functions/frame_residual.h"
 #include "cost_functions/spatial_tv_residual.h"
 #include "cost_functions/weighted_l1_loss.h"
+#include "solver/objective_terms.h"
 
 namespace evfs {
 namespace {
@@ -82,11 +83,13 @@ ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) 
   return *this;
 }
 
-// What every part of a scene shares: which pixels are solved for and how their time series are
-// cut into segments.
+// What every part of a scene shares: which pixels are solved for, how their time series are
+// cut into segments, and which terms the objective has. The mask is on the heap: `terms`
+// refers to it.
 struct ProblemBuilder::Prepared {
-  ActivityMask mask;
+  std::shared_ptr<const ActivityMask> mask;
   std::shared_ptr<const LatentLayout> layout;
+  std::shared_ptr<const ObjectiveTerms> terms;
 };
 
 ProblemBuilder::ProblemBuilder(const Scene& scene, const ReconstructionOptions& options)
@@ -97,22 +100,24 @@ ProblemBuilder::Prepared ProblemBuilder::Prepare(Video* latent) const {
       latent->width() != scene_.width) {
     throw InvalidArgumentError("the latent video does not match the scene's size");
   }
-  Prepared prepared{ActivityMask(scene_.events, options_.activity_radius_px), nullptr};
+  Prepared prepared;
+  prepared.mask = std::make_shared<ActivityMask>(scene_.events, options_.activity_radius_px);
   auto layout =
-      std::make_shared<LatentLayout>(scene_, prepared.mask, *latent, options_.merge_quiet_steps);
+      std::make_shared<LatentLayout>(scene_, *prepared.mask, *latent, options_.merge_quiet_steps);
   layout->ProjectOnto(latent);
   prepared.layout = std::move(layout);
+  prepared.terms = std::make_shared<ObjectiveTerms>(scene_, options_.objective, *prepared.mask);
   return prepared;
 }
 
 std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   const Prepared prepared = Prepare(latent);
   std::vector<int64_t> pixels;
-  for (int64_t p = 0; p < prepared.mask.num_pixels(); ++p) {
-    if (prepared.mask.in_problem(p)) pixels.push_back(p);
+  for (int64_t p = 0; p < prepared.mask->num_pixels(); ++p) {
+    if (prepared.mask->in_problem(p)) pixels.push_back(p);
   }
   std::unique_ptr<BuiltProblem> built = BuildPart(prepared, pixels, latent);
-  built->statistics_.skipped_pixels = prepared.mask.num_pixels() - prepared.mask.num_active();
+  built->statistics_.skipped_pixels = prepared.mask->num_pixels() - prepared.mask->num_active();
   return built;
 }
 
@@ -120,7 +125,7 @@ std::vector<std::unique_ptr<BuiltProblem>> ProblemBuilder::BuildParts(Video* lat
                                                                       int build_workers) const {
   const Prepared prepared = Prepare(latent);
   const std::vector<std::vector<int64_t>> parts =
-      prepared.mask.IndependentParts(options_.min_part_pixels);
+      prepared.mask->IndependentParts(options_.min_part_pixels);
   std::vector<std::unique_ptr<BuiltProblem>> built(parts.size());
   ParallelForEach(static_cast<int>(parts.size()), build_workers,
                   [&](int i) { built[i] = BuildPart(prepared, parts[i], latent); });
@@ -131,10 +136,11 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
                                                         const std::vector<int64_t>& pixels,
                                                         Video* latent) const {
   const ObjectiveOptions& objective = options_.objective;
-  const ActivityMask& mask = prepared.mask;
+  const ActivityMask& mask = *prepared.mask;
   const LatentLayout& layout = *prepared.layout;
+  const ObjectiveTerms& terms = *prepared.terms;
   const int num_latent = scene_.num_latent_frames();
-  const int width = scene_.width, height = scene_.height;
+  const int width = scene_.width;
 
   auto built = std::make_unique<BuiltProblem>();
   built->layout_ = prepared.layout;
@@ -176,8 +182,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     });
   }
 
-  // Each family's loss is weight / (h·w) times the smoothed |r| (ObjectiveOptions).
-  const double per_pixel = 1.0 / static_cast<double>(layout.pixels_per_frame());
+  // Each family's loss is its normalised weight (ObjectiveTerms) times the smoothed |r|.
   const auto block = [&](int t, int64_t p) {
     return layout.value(layout.segment_at(t, p), latent);
   };
@@ -185,8 +190,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
   std::vector<double*> blocks;
   std::vector<int> shape;
 
-  if (objective.frame_weight > 0.0) {
-    ceres::LossFunction* loss = losses.Get(objective.frame_weight * per_pixel, 1);
+  if (terms.has(TermFamily::kFrame)) {
+    ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kFrame), 1);
     for (const FrameObservation& frame : scene_.frames) {
       for (const int64_t p : pixels) {
         if (!mask.active(p)) continue;
@@ -211,8 +216,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     }
   }
 
-  if (objective.event_weight > 0.0) {
-    ceres::LossFunction* loss = losses.Get(objective.event_weight * per_pixel, 1);
+  if (terms.has(TermFamily::kEvent)) {
+    ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kEvent), 1);
     for (int k = 0; k < scene_.events.num_frames(); ++k) {
       const EventFrameSpan& span = scene_.events.span(k);
       const int steps = span.latent_last - span.latent_first;
@@ -245,10 +250,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     }
   }
 
-  if (objective.spatial_tv_weight > 0.0) {
-    // A mean over latent frames: summed, smoothing a run of m frames would save m times the
-    // TV while paying for only two temporal transitions, so finer binning would blur more.
-    const double weight = objective.spatial_tv_weight * per_pixel / num_latent;
+  if (terms.has(TermFamily::kSpatialTv)) {
+    const double weight = terms.weight(TermFamily::kSpatialTv);
     // Anisotropic TV is two difference residuals; the other forms one three-point residual.
     const bool anisotropic = objective.spatial_tv == SpatialTv::kAnisotropic;
     ceres::CostFunction* spatial_cost = cache.Get(Family::kSpatialTv, 0.0, {}, [&] {
@@ -273,27 +276,23 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
         run_first = t;
       }
     };
-    // A term is built when any pixel it touches is active; the others are then in the problem
-    // (within one pixel of an active one) and in the same part, and the term is built by the
-    // part of its top-left pixel.
+    // A term touches an active pixel (ObjectiveTerms), so the others it touches are in the
+    // problem (within one pixel of an active one) and in the same part; it is built by the part
+    // of its top-left pixel.
     for (const int64_t p : pixels) {
-      const int y = static_cast<int>(p / width), x = static_cast<int>(p % width);
-      const bool has_right = x + 1 < width, has_below = y + 1 < height;
-      const bool here = mask.active(p);
-      const bool right = has_right && mask.active(p + 1);
-      const bool below = has_below && mask.active(p + width);
+      const SpatialTvTermsAt owned = terms.spatial_tv_terms_at(p);
       if (anisotropic) {
-        if (has_right && (here || right)) add_runs({p, p + 1});
-        if (has_below && (here || below)) add_runs({p, p + width});
-      } else if (has_right && has_below && (here || right || below)) {
+        if (owned.right) add_runs({p, p + 1});
+        if (owned.below) add_runs({p, p + width});
+      } else if (owned.right) {
         add_runs({p, p + 1, p + width});
       }
     }
   }
 
-  if (objective.temporal_tv_weight > 0.0 && num_latent > 1) {
+  if (terms.has(TermFamily::kTemporalTv)) {
     // Σ_t |H_{t+1}(p) - H_t(p)| is the sum over the pixel's segment boundaries.
-    ceres::LossFunction* loss = losses.Get(objective.temporal_tv_weight * per_pixel, 1);
+    ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kTemporalTv), 1);
     ceres::CostFunction* difference =
         cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
     for (const int64_t p : pixels) {

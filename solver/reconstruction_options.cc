@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/option_checker.h"
+
 namespace evfs {
 namespace {
 
@@ -10,30 +12,22 @@ bool IsNonNegativeFinite(double value) { return std::isfinite(value) && value >=
 }  // namespace
 
 bool ObjectiveOptions::IsValid(std::string* error) const {
-  if (!IsNonNegativeFinite(frame_weight) || !IsNonNegativeFinite(event_weight) ||
-      !IsNonNegativeFinite(spatial_tv_weight) || !IsNonNegativeFinite(temporal_tv_weight)) {
-    *error = "term weights must be finite and non-negative";
-    return false;
-  }
-  if (frame_weight == 0.0 && event_weight == 0.0 && spatial_tv_weight == 0.0 &&
-      temporal_tv_weight == 0.0) {
-    *error = "at least one term weight must be positive";
-    return false;
-  }
-  if (!(std::isfinite(smoothing_scale) && smoothing_scale > 0.0)) {
-    *error = "smoothing_scale must be positive";
-    return false;
-  }
-  if (!std::isfinite(event_model.alpha)) {
-    *error = "alpha must be finite (<= 0 derives it from the data)";
-    return false;
-  }
-  if (event_model.model == EventModel::kLog &&
-      !(std::isfinite(event_model.log_offset) && event_model.log_offset > 0.0)) {
-    *error = "log_offset (b of log(x + b)) must be positive";
-    return false;
-  }
-  return true;
+  OptionChecker check;
+  check
+      .Check(IsNonNegativeFinite(frame_weight) && IsNonNegativeFinite(event_weight) &&
+                 IsNonNegativeFinite(spatial_tv_weight) && IsNonNegativeFinite(temporal_tv_weight),
+             "term weights must be finite and non-negative")
+      .Check(frame_weight != 0.0 || event_weight != 0.0 || spatial_tv_weight != 0.0 ||
+                 temporal_tv_weight != 0.0,
+             "at least one term weight must be positive")
+      .Check(std::isfinite(smoothing_scale) && smoothing_scale > 0.0,
+             "smoothing_scale must be positive")
+      .Check(std::isfinite(event_model.alpha),
+             "alpha must be finite (<= 0 derives it from the data)")
+      .Check(event_model.model != EventModel::kLog ||
+                 (std::isfinite(event_model.log_offset) && event_model.log_offset > 0.0),
+             "log_offset (b of log(x + b)) must be positive");
+  return check.Passed(error);
 }
 
 ceres::Solver::Options DefaultSolverOptions() {
@@ -59,60 +53,33 @@ ceres::Solver::Options DefaultSolverOptions() {
   return options;
 }
 
-const char* SpatialTvName(SpatialTv form) {
-  switch (form) {
-    case SpatialTv::kPaper:
-      return "paper";
-    case SpatialTv::kAnisotropic:
-      return "anisotropic";
-    case SpatialTv::kIsotropic:
-      return "isotropic";
-  }
-  return "";
-}
+const char* SpatialTvName(SpatialTv form) { return NameOf(kSpatialTvNames, form); }
 
 bool ParseSpatialTv(const std::string& name, SpatialTv* form) {
-  for (const SpatialTv candidate :
-       {SpatialTv::kPaper, SpatialTv::kAnisotropic, SpatialTv::kIsotropic}) {
-    if (name == SpatialTvName(candidate)) {
-      *form = candidate;
-      return true;
-    }
-  }
-  return false;
+  return FindName(kSpatialTvNames, name, form);
 }
 
-const char* EventModelName(EventModel model) {
-  return model == EventModel::kLog ? "log" : "linear";
-}
+const char* EventModelName(EventModel model) { return NameOf(kEventModelNames, model); }
 
 bool ParseEventModel(const std::string& name, EventModel* model) {
-  if (name != "linear" && name != "log") return false;
-  *model = name == "log" ? EventModel::kLog : EventModel::kLinear;
-  return true;
+  return FindName(kEventModelNames, name, model);
 }
 
 ReconstructionOptions::ReconstructionOptions() : solver(DefaultSolverOptions()) {}
 
 bool ReconstructionOptions::IsValid(std::string* error) const {
-  if (!objective.IsValid(error) || !estimation.IsValid(error)) return false;
-  if (bound_intensities && solver.minimizer_type == ceres::LINE_SEARCH) {
-    *error =
-        "Ceres' line-search minimiser cannot keep intensities in [0, 1]: turn the bounds "
-        "off or use the trust-region minimiser";
-    return false;
-  }
+  OptionChecker check;
+  check.Valid(objective)
+      .Valid(estimation)
+      .Check(!(bound_intensities && solver.minimizer_type == ceres::LINE_SEARCH),
+             "Ceres' line-search minimiser cannot keep intensities in [0, 1]: turn the bounds "
+             "off or use the trust-region minimiser");
   for (const double scale : smoothing_continuation) {
-    if (!(scale > 0.0) || !std::isfinite(scale)) {
-      *error = "every smoothing_continuation scale must be positive and finite";
-      return false;
-    }
+    check.Check(scale > 0.0 && std::isfinite(scale),
+                "every smoothing_continuation scale must be positive and finite");
   }
-  if (min_part_pixels < 1) {
-    *error = "min_part_pixels must be at least 1";
-    return false;
-  }
-  return solver.IsValid(error);
+  check.Check(min_part_pixels >= 1, "min_part_pixels must be at least 1").Valid(solver);
+  return check.Passed(error);
 }
 
 }  // namespace evfs

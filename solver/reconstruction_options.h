@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "cost_functions/spatial_tv_residual.h"
 #include "scene/event_model.h"
 #include "scene/event_model_estimation.h"
@@ -101,11 +102,20 @@ struct ReconstructionOptions {
 /// a Jacobi preconditioner is used (../shared/notes/solver-measurements.md).
 ceres::Solver::Options DefaultSolverOptions();
 
-/// Names used by flags and summaries: "paper", "anisotropic", "isotropic" and "linear", "log".
+/// Names used by flags and summaries (kEventModelNames is in scene/event_model.h).
+inline constexpr EnumName<SpatialTv> kSpatialTvNames[] = {
+    {SpatialTv::kPaper, "paper", "|dx+dy| (paper Eq. 4)"},
+    {SpatialTv::kAnisotropic, "anisotropic", "|dx|+|dy|"},
+    {SpatialTv::kIsotropic, "isotropic", "sqrt(dx^2+dy^2)"},
+};
+
+/// "paper", "anisotropic", "isotropic".
 const char* SpatialTvName(SpatialTv form);
 /// Parses a name of SpatialTvName; false when unknown.
 bool ParseSpatialTv(const std::string& name, SpatialTv* form);
+/// "linear", "log".
 const char* EventModelName(EventModel model);
+/// Parses a name of EventModelName; false when unknown.
 bool ParseEventModel(const std::string& name, EventModel* model);
 
 }  // namespace evfs

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tests/scene/scene_test_scenes.h"
+#include "tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {
@@ -26,21 +27,6 @@ Scene MakeTinyScene() {
   scene.num_events = 1;
   scene.frames.push_back({Image::Constant(4, 5, 0.2), 0, 0, "first"});
   scene.frames.push_back({Image::Constant(4, 5, 0.6), 3, 3, "last"});
-  return scene;
-}
-
-// A height × width scene like MakeTinyScene, with one ON event per {step, y, x} given.
-Scene MakeSceneWithEvents(int height, int width, const std::vector<std::array<int, 3>>& events) {
-  Scene scene;
-  scene.height = height;
-  scene.width = width;
-  scene.events = EventFrames(height, width);
-  for (int k = 0; k < 3; ++k) scene.events.AddFrame({k, k + 1, 10 * k, 10 * k + 5, 1});
-  scene.events.set_latent_timestamps_ns({0, 10, 20, 30});
-  for (const auto& [step, y, x] : events) scene.events.value(step, y, x) = 1.0f;
-  scene.num_events = static_cast<int64_t>(events.size());
-  scene.frames.push_back({Image::Constant(height, width, 0.2), 0, 0, "first"});
-  scene.frames.push_back({Image::Constant(height, width, 0.6), 3, 3, "last"});
   return scene;
 }
 

@@ -1,7 +1,8 @@
 // Checks the fields of an XxxOptions struct for its IsValid, keeping the first failure as a
-// readable reason. Shared by the options of binning, the simulator and the scene synthesizer.
-#ifndef EVFS_EVENTS_OPTION_CHECKER_H_
-#define EVFS_EVENTS_OPTION_CHECKER_H_
+// readable reason. Every IsValid of the project goes through it, so all of them treat `error`
+// the same way: it may be null, it receives the first failure and it is cleared on success.
+#ifndef EVFS_CORE_OPTION_CHECKER_H_
+#define EVFS_CORE_OPTION_CHECKER_H_
 
 #include <cmath>
 #include <string>
@@ -10,7 +11,7 @@ namespace evfs {
 
 /// Chained requirements; after the first failure the others are skipped.
 ///   OptionChecker check;
-///   check.Positive("log_eps", log_eps).AtLeast("num_frames", num_frames, 1);
+///   check.Positive("log_eps", log_eps).InRange("num_frames", num_frames, 1, 1000);
 ///   return check.Passed(error);
 class OptionChecker {
  public:
@@ -26,16 +27,35 @@ class OptionChecker {
 
   /// Requires an integer in [low, high].
   OptionChecker& InRange(const char* name, long long value, long long low, long long high) {
-    return Require(value >= low && value <= high, name,
+    if (!reason_.empty() || (value >= low && value <= high)) return *this;
+    return Require(false, name,
                    "in [" + std::to_string(low) + ", " + std::to_string(high) + "], got " +
                        std::to_string(value));
   }
 
   /// Requires `ok`; otherwise "`name` must be `expected`" becomes the reason.
   OptionChecker& Require(bool ok, const std::string& name, const std::string& expected) {
-    if (reason_.empty() && !ok) reason_ = name + " must be " + expected;
+    return Check(ok, name + " must be " + expected);
+  }
+
+  /// Requires `ok`; otherwise `reason`, word for word, becomes the reason.
+  OptionChecker& Check(bool ok, const std::string& reason) {
+    if (reason_.empty() && !ok) reason_ = reason.empty() ? "invalid options" : reason;
     return *this;
   }
+
+  /// Requires `nested.IsValid` (nested options: ours, or Ceres' solver options, whose IsValid
+  /// needs a non-null error); its reason becomes ours. Skipped after an earlier failure.
+  template <typename Options>
+  OptionChecker& Valid(const Options& nested) {
+    if (!reason_.empty()) return *this;
+    std::string reason;
+    if (!nested.IsValid(&reason)) Check(false, reason);
+    return *this;
+  }
+
+  /// True while no requirement has failed.
+  bool ok() const { return reason_.empty(); }
 
   /// True when every requirement held; otherwise false with the first failure in `error`
   /// (which may be null). `error` is cleared on success.
@@ -50,4 +70,4 @@ class OptionChecker {
 
 }  // namespace evfs
 
-#endif  // EVFS_EVENTS_OPTION_CHECKER_H_
+#endif  // EVFS_CORE_OPTION_CHECKER_H_

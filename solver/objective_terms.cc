@@ -1,0 +1,65 @@
+#include "solver/objective_terms.h"
+
+#include "core/error.h"
+
+namespace evfs {
+
+ObjectiveTerms::ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objective,
+                               const ActivityMask& mask)
+    : mask_(mask), height_(scene.height), width_(scene.width), spatial_tv_(objective.spatial_tv) {
+  const int64_t pixels = static_cast<int64_t>(height_) * width_;
+  if (mask.num_pixels() != pixels) {
+    throw InvalidArgumentError("objective terms: the activity mask does not match the scene");
+  }
+  const int num_latent = scene.num_latent_frames();
+  const double per_pixel = 1.0 / static_cast<double>(pixels);
+  const auto family_weight = [](double weight) { return weight > 0.0 ? weight : 0.0; };
+  weights_[static_cast<int>(TermFamily::kFrame)] =
+      family_weight(objective.frame_weight) * per_pixel;
+  weights_[static_cast<int>(TermFamily::kEvent)] =
+      family_weight(objective.event_weight) * per_pixel;
+  weights_[static_cast<int>(TermFamily::kSpatialTv)] =
+      family_weight(objective.spatial_tv_weight) * per_pixel / num_latent;
+  weights_[static_cast<int>(TermFamily::kTemporalTv)] =
+      num_latent > 1 ? family_weight(objective.temporal_tv_weight) * per_pixel : 0.0;
+
+  const int64_t active = mask.num_active();
+  if (has(TermFamily::kFrame)) {
+    counts_[static_cast<int>(TermFamily::kFrame)] =
+        static_cast<int64_t>(scene.frames.size()) * active;
+  }
+  if (has(TermFamily::kEvent)) {
+    counts_[static_cast<int>(TermFamily::kEvent)] =
+        static_cast<int64_t>(scene.events.num_frames()) * active;
+  }
+  if (has(TermFamily::kSpatialTv)) {
+    int64_t per_frame = 0;
+    for (int64_t p = 0; p < pixels; ++p) {
+      const SpatialTvTermsAt terms = spatial_tv_terms_at(p);
+      per_frame += terms.right + terms.below;
+    }
+    counts_[static_cast<int>(TermFamily::kSpatialTv)] = per_frame * num_latent;
+  }
+  if (has(TermFamily::kTemporalTv)) {
+    counts_[static_cast<int>(TermFamily::kTemporalTv)] = (num_latent - 1) * active;
+  }
+}
+
+SpatialTvTermsAt ObjectiveTerms::spatial_tv_terms_at(int64_t p) const {
+  SpatialTvTermsAt terms;
+  if (!has(TermFamily::kSpatialTv)) return terms;
+  const int y = static_cast<int>(p / width_), x = static_cast<int>(p % width_);
+  const bool has_right = x + 1 < width_, has_below = y + 1 < height_;
+  const bool here = mask_.active(p);
+  const bool right = has_right && mask_.active(p + 1);
+  const bool below = has_below && mask_.active(p + width_);
+  if (spatial_tv_ == SpatialTv::kAnisotropic) {
+    terms.right = has_right && (here || right);
+    terms.below = has_below && (here || below);
+  } else {
+    terms.right = has_right && has_below && (here || right || below);
+  }
+  return terms;
+}
+
+}  // namespace evfs

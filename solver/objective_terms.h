@@ -1,0 +1,71 @@
+// Which terms the objective of DESIGN.md §1 has for a scene, and their weights: the one
+// definition that ProblemBuilder (Ceres residual blocks) and FusedObjective (Adam, L-BFGS) both
+// follow.
+//
+//   L(H) = w_f  / (hw)   · Σ_j Σ_p ρ(frame term j at p)             (Eq. 3)
+//        + λ_e  / (hw)   · Σ_k Σ_p ρ(event term k at p)             (Eqs. 1–2)
+//        + λ_xy / (hw·N) · Σ_t Σ_p ρ(spatial TV term at (t, p))     (Eq. 4)
+//        + λ_t  / (hw)   · Σ_t Σ_p ρ(H_{t+1}(p) − H_t(p))           (Eq. 5)
+//
+// Rules:
+// * A family with weight 0 has no terms; the temporal family has none with one latent frame.
+// * Frame, event and temporal terms are summed over the active pixels (ActivityMask) only.
+// * A spatial TV term exists when any pixel it touches is active; it belongs to its top-left
+//   pixel. Anisotropic TV is two terms per pixel, (p, right) and (p, below); the paper and
+//   isotropic forms one three-point term (p, right, below).
+// * Every family is normalised by the image size h·w, so that the weights do not depend on the
+//   resolution; spatial TV also by the N latent frames (a mean over frames: summed, smoothing a
+//   run of m frames would save m times the TV while paying for only two temporal transitions, so
+//   finer binning would blur more).
+#ifndef EVFS_SOLVER_OBJECTIVE_TERMS_H_
+#define EVFS_SOLVER_OBJECTIVE_TERMS_H_
+
+#include <array>
+#include <cstdint>
+
+#include "scene/activity_mask.h"
+#include "scene/scene.h"
+#include "solver/reconstruction_options.h"
+
+namespace evfs {
+
+/// The residual families of the objective.
+enum class TermFamily { kFrame, kEvent, kSpatialTv, kTemporalTv };
+constexpr int kNumTermFamilies = 4;
+
+/// The spatial TV terms a pixel owns (as their top-left pixel).
+struct SpatialTvTermsAt {
+  /// Anisotropic: the term (p, p + 1). Paper and isotropic forms: the term (p, p + 1, p + w).
+  bool right = false;
+  /// Anisotropic only: the term (p, p + w).
+  bool below = false;
+};
+
+/// The terms of the objective for one scene, activity mask and objective options. Counts are of
+/// terms over voxels (one per latent frame or step, before any merging of quiet steps).
+class ObjectiveTerms {
+ public:
+  /// `mask` must match the scene's size and outlive this object.
+  ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objective, const ActivityMask& mask);
+
+  /// Whether the family has terms: weight > 0 (and, for temporal TV, more than one latent frame).
+  bool has(TermFamily family) const { return weight(family) > 0.0; }
+  /// The weight of each of the family's terms, normalisation included; 0 when it has none.
+  double weight(TermFamily family) const { return weights_[static_cast<int>(family)]; }
+  /// Number of the family's terms (0 when it has none).
+  int64_t num_terms(TermFamily family) const { return counts_[static_cast<int>(family)]; }
+
+  /// The spatial TV terms pixel p owns; none when the family has no terms.
+  SpatialTvTermsAt spatial_tv_terms_at(int64_t p) const;
+
+ private:
+  const ActivityMask& mask_;
+  int height_ = 0, width_ = 0;
+  SpatialTv spatial_tv_ = SpatialTv::kAnisotropic;
+  std::array<double, kNumTermFamilies> weights_{};
+  std::array<int64_t, kNumTermFamilies> counts_{};
+};
+
+}  // namespace evfs
+
+#endif  // EVFS_SOLVER_OBJECTIVE_TERMS_H_

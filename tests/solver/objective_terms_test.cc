@@ -1,0 +1,175 @@
+#include "solver/objective_terms.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "scene/activity_mask.h"
+#include "solver/problem_builder.h"
+#include "tests/solver/solver_test_scenes.h"
+
+namespace evfs {
+namespace {
+
+constexpr int kHeight = 4;
+constexpr int kWidth = 5;
+constexpr int kPixels = kHeight * kWidth;
+constexpr int kNumLatent = 4;  // three collision steps
+
+// The 5×4 scene of MakeSceneWithEvents, with one ON event per {step, y, x} given.
+Scene MakeScene(const std::vector<std::array<int, 3>>& events) {
+  return MakeSceneWithEvents(kHeight, kWidth, events);
+}
+
+ObjectiveOptions MakeObjective(SpatialTv form) {
+  ObjectiveOptions objective;
+  objective.frame_weight = 1.3;
+  objective.event_weight = 0.7;
+  objective.spatial_tv_weight = 2.0;
+  objective.temporal_tv_weight = 1.5;
+  objective.spatial_tv = form;
+  objective.event_model.alpha = 5.0;
+  return objective;
+}
+
+TEST(ObjectiveTerms, WeightsAreNormalisedByImageSizeAndSpatialTvByFrames) {
+  const Scene scene = MakeScene({{1, 2, 3}});
+  const ActivityMask mask(scene.events, /*radius_px=*/-1);
+  const ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+  const ObjectiveTerms terms(scene, objective, mask);
+  // Products and quotients of a few doubles: equal to within an ulp or two.
+  EXPECT_DOUBLE_EQ(terms.weight(TermFamily::kFrame), 1.3 / kPixels);
+  EXPECT_DOUBLE_EQ(terms.weight(TermFamily::kEvent), 0.7 / kPixels);
+  EXPECT_DOUBLE_EQ(terms.weight(TermFamily::kSpatialTv), 2.0 / kPixels / kNumLatent);
+  EXPECT_DOUBLE_EQ(terms.weight(TermFamily::kTemporalTv), 1.5 / kPixels);
+  for (const TermFamily family :
+       {TermFamily::kFrame, TermFamily::kEvent, TermFamily::kSpatialTv, TermFamily::kTemporalTv}) {
+    EXPECT_TRUE(terms.has(family));
+  }
+}
+
+TEST(ObjectiveTerms, CountsTermsOverVoxelsOfActivePixels) {
+  const Scene scene = MakeScene({{1, 2, 3}});
+  const ActivityMask every_pixel(scene.events, /*radius_px=*/-1);
+  const ObjectiveTerms anisotropic(scene, MakeObjective(SpatialTv::kAnisotropic), every_pixel);
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kFrame), 2 * kPixels);
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kEvent), 3 * kPixels);
+  // Horizontal (4 rows × 4) plus vertical (3 rows × 5) differences per frame.
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kSpatialTv), kNumLatent * (4 * 4 + 3 * 5));
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kTemporalTv), 3 * kPixels);
+  // One three-point term per pixel with a right and a lower neighbour.
+  const ObjectiveTerms paper(scene, MakeObjective(SpatialTv::kPaper), every_pixel);
+  EXPECT_EQ(paper.num_terms(TermFamily::kSpatialTv), kNumLatent * (3 * 4));
+}
+
+TEST(ObjectiveTerms, ZeroWeightFamiliesHaveNoTerms) {
+  const Scene scene = MakeScene({{1, 2, 3}});
+  const ActivityMask mask(scene.events, /*radius_px=*/-1);
+  for (int family = 0; family < kNumTermFamilies; ++family) {
+    ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+    double* weights[] = {&objective.frame_weight, &objective.event_weight,
+                         &objective.spatial_tv_weight, &objective.temporal_tv_weight};
+    *weights[family] = 0.0;
+    SCOPED_TRACE("family " + std::to_string(family) + " has weight 0");
+    const ObjectiveTerms terms(scene, objective, mask);
+    for (int other = 0; other < kNumTermFamilies; ++other) {
+      const TermFamily f = static_cast<TermFamily>(other);
+      EXPECT_EQ(terms.has(f), other != family);
+      EXPECT_EQ(terms.weight(f) > 0.0, other != family);
+      EXPECT_EQ(terms.num_terms(f) > 0, other != family);
+    }
+    if (family == static_cast<int>(TermFamily::kSpatialTv)) {
+      for (int64_t p = 0; p < kPixels; ++p) {
+        EXPECT_FALSE(terms.spatial_tv_terms_at(p).right);
+        EXPECT_FALSE(terms.spatial_tv_terms_at(p).below);
+      }
+    }
+  }
+}
+
+TEST(ObjectiveTerms, OneLatentFrameHasNoTemporalTerms) {
+  Scene scene;
+  scene.height = kHeight;
+  scene.width = kWidth;
+  scene.events = EventFrames(kHeight, kWidth);
+  scene.events.set_latent_timestamps_ns({0});
+  scene.frames.push_back({Image::Constant(kHeight, kWidth, 0.2), 0, 0, "only"});
+  ASSERT_EQ(scene.num_latent_frames(), 1);
+  const ActivityMask mask(scene.events, /*radius_px=*/-1);
+  const ObjectiveTerms terms(scene, MakeObjective(SpatialTv::kAnisotropic), mask);
+  EXPECT_FALSE(terms.has(TermFamily::kTemporalTv));
+  EXPECT_EQ(terms.weight(TermFamily::kTemporalTv), 0.0);
+  EXPECT_EQ(terms.num_terms(TermFamily::kTemporalTv), 0);
+  EXPECT_TRUE(terms.has(TermFamily::kFrame));
+}
+
+// One event at (y, x) = (2, 3) with radius 0: only that pixel is active. A spatial TV term
+// exists when any pixel it touches is active, and belongs to its top-left pixel.
+TEST(ObjectiveTerms, SpatialTvTermsTouchAnActivePixel) {
+  const Scene scene = MakeScene({{1, 2, 3}});
+  const ActivityMask mask(scene.events, /*radius_px=*/0);
+  ASSERT_EQ(mask.num_active(), 1);
+  const int64_t active = 2 * kWidth + 3;
+  const int64_t left = active - 1, above = active - kWidth, above_left = above - 1;
+
+  const ObjectiveTerms anisotropic(scene, MakeObjective(SpatialTv::kAnisotropic), mask);
+  for (int64_t p = 0; p < kPixels; ++p) {
+    const SpatialTvTermsAt owned = anisotropic.spatial_tv_terms_at(p);
+    EXPECT_EQ(owned.right, p == active || p == left) << "pixel " << p;
+    EXPECT_EQ(owned.below, p == active || p == above) << "pixel " << p;
+  }
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kSpatialTv), kNumLatent * 4);
+
+  for (const SpatialTv form : {SpatialTv::kPaper, SpatialTv::kIsotropic}) {
+    SCOPED_TRACE(SpatialTvName(form));
+    const ObjectiveTerms three_point(scene, MakeObjective(form), mask);
+    for (int64_t p = 0; p < kPixels; ++p) {
+      const SpatialTvTermsAt owned = three_point.spatial_tv_terms_at(p);
+      EXPECT_EQ(owned.right, p == active || p == left || p == above) << "pixel " << p;
+      EXPECT_FALSE(owned.below) << "pixel " << p;
+    }
+    EXPECT_EQ(three_point.num_terms(TermFamily::kSpatialTv), kNumLatent * 3);
+    EXPECT_EQ(three_point.spatial_tv_terms_at(above_left).right, false);
+  }
+  // Frame, event and temporal terms: the active pixel's only.
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kFrame), 2);
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kEvent), 3);
+  EXPECT_EQ(anisotropic.num_terms(TermFamily::kTemporalTv), 3);
+}
+
+// The Ceres problem builds exactly these terms: with one parameter block per voxel, one
+// residual block per term.
+TEST(ObjectiveTerms, ProblemBuilderBuildsTheseTerms) {
+  const Scene scene = MakeScene({{0, 1, 1}, {1, 2, 3}, {2, 2, 3}});
+  for (const SpatialTv form : {SpatialTv::kPaper, SpatialTv::kAnisotropic, SpatialTv::kIsotropic}) {
+    for (const int radius : {-1, 0, 1}) {
+      SCOPED_TRACE(std::string(SpatialTvName(form)) + " radius " + std::to_string(radius));
+      ReconstructionOptions options;
+      options.objective = MakeObjective(form);
+      options.activity_radius_px = radius;
+      options.merge_quiet_steps = false;
+      Video latent = InitializeLatentVideo(scene);
+      const auto built = ProblemBuilder(scene, options).Build(&latent);
+      const ProblemStatistics& statistics = built->statistics();
+      const ActivityMask mask(scene.events, radius);
+      const ObjectiveTerms terms(scene, options.objective, mask);
+      EXPECT_EQ(statistics.frame_residuals, terms.num_terms(TermFamily::kFrame));
+      EXPECT_EQ(statistics.event_residuals, terms.num_terms(TermFamily::kEvent));
+      EXPECT_EQ(statistics.spatial_tv_residuals, terms.num_terms(TermFamily::kSpatialTv));
+      EXPECT_EQ(statistics.temporal_tv_residuals, terms.num_terms(TermFamily::kTemporalTv));
+    }
+  }
+}
+
+TEST(ObjectiveTerms, RejectsAMaskOfAnotherSize) {
+  const Scene scene = MakeScene({{1, 2, 3}});
+  const ActivityMask mask(EventFrames(kHeight + 1, kWidth), /*radius_px=*/-1);
+  EXPECT_THROW(ObjectiveTerms(scene, MakeObjective(SpatialTv::kAnisotropic), mask),
+               InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace evfs
