@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
-#include "app/json_writer.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
@@ -213,70 +213,75 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
 
 namespace {
 
-void WriteCeresLm(const ReconstructionOptions& options, const ReconstructionSummary& summary,
-                  JsonWriter* json) {
-  json->Field("linear_solver", ceres::LinearSolverTypeToString(options.solver.linear_solver_type));
-  json->Field("preconditioner",
-              ceres::PreconditionerTypeToString(options.solver.preconditioner_type));
-  json->Field("eta", options.solver.eta);
-  json->Field("max_iterations", options.solver.max_num_iterations);
-  json->Field("function_tolerance", options.solver.function_tolerance);
-  json->Field("threads", options.solver.num_threads);
+using Json = nlohmann::ordered_json;
+
+// JSON has no inf or nan: they become null.
+Json Number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
+
+void AddCeresLm(const ReconstructionOptions& options, const ReconstructionSummary& summary,
+                Json* solver) {
+  Json& json = *solver;
+  json["linear_solver"] = ceres::LinearSolverTypeToString(options.solver.linear_solver_type);
+  json["preconditioner"] = ceres::PreconditionerTypeToString(options.solver.preconditioner_type);
+  json["eta"] = Number(options.solver.eta);
+  json["max_iterations"] = options.solver.max_num_iterations;
+  json["function_tolerance"] = Number(options.solver.function_tolerance);
+  json["threads"] = options.solver.num_threads;
   if (!summary.solved) return;
-  json->Field("termination", ceres::TerminationTypeToString(summary.ceres.termination_type));
+  json["termination"] = ceres::TerminationTypeToString(summary.ceres.termination_type);
   // Where Ceres' time went (its own accounting).
-  json->Key("time_s").BeginObject();
-  json->Field("preprocessor", summary.ceres.preprocessor_time_in_seconds);
-  json->Field("residual_evaluation", summary.ceres.residual_evaluation_time_in_seconds);
-  json->Field("jacobian_evaluation", summary.ceres.jacobian_evaluation_time_in_seconds);
-  json->Field("linear_solver", summary.ceres.linear_solver_time_in_seconds);
-  json->Field("minimizer", summary.ceres.minimizer_time_in_seconds);
-  json->EndObject();
-  json->Field("successful_steps", summary.ceres.num_successful_steps);
-  json->Field("unsuccessful_steps", summary.ceres.num_unsuccessful_steps);
+  json["time_s"] = {
+      {"preprocessor", Number(summary.ceres.preprocessor_time_in_seconds)},
+      {"residual_evaluation", Number(summary.ceres.residual_evaluation_time_in_seconds)},
+      {"jacobian_evaluation", Number(summary.ceres.jacobian_evaluation_time_in_seconds)},
+      {"linear_solver", Number(summary.ceres.linear_solver_time_in_seconds)},
+      {"minimizer", Number(summary.ceres.minimizer_time_in_seconds)},
+  };
+  json["successful_steps"] = summary.ceres.num_successful_steps;
+  json["unsuccessful_steps"] = summary.ceres.num_unsuccessful_steps;
 }
 
-void WriteModel(const ObjectiveOptions& objective, const ReconstructionSummary& summary,
-                JsonWriter* json) {
-  json->Key("model").BeginObject();
-  json->Field("event_model", EventModelName(objective.event_model.model));
-  json->Field("alpha", summary.model.alpha);
-  json->Field("alpha_derived", summary.alpha_derived);
+Json ModelJson(const ObjectiveOptions& objective, const ReconstructionSummary& summary) {
+  Json json;
+  json["event_model"] = EventModelName(objective.event_model.model);
+  json["alpha"] = Number(summary.model.alpha);
+  json["alpha_derived"] = summary.alpha_derived;
   if (summary.alpha_derived) {
-    json->Field("change_per_event", summary.model.change_per_event);
-    json->Field("change_measured_from_frames", summary.model.estimated_from_frames);
+    json["change_per_event"] = Number(summary.model.change_per_event);
+    json["change_measured_from_frames"] = summary.model.estimated_from_frames;
   }
-  json->Field("frame_weight", objective.frame_weight);
-  json->Field("event_weight", objective.event_weight);
-  json->Field("spatial_tv_weight", objective.spatial_tv_weight);
-  json->Field("temporal_tv_weight", objective.temporal_tv_weight);
-  json->Field("spatial_tv", SpatialTvName(objective.spatial_tv));
-  json->Field("smoothing_scale", objective.smoothing_scale);
-  json->EndObject();
+  json["frame_weight"] = Number(objective.frame_weight);
+  json["event_weight"] = Number(objective.event_weight);
+  json["spatial_tv_weight"] = Number(objective.spatial_tv_weight);
+  json["temporal_tv_weight"] = Number(objective.temporal_tv_weight);
+  json["spatial_tv"] = SpatialTvName(objective.spatial_tv);
+  json["smoothing_scale"] = Number(objective.smoothing_scale);
+  return json;
 }
 
-void WriteProblem(const ReconstructionOptions& options, const ProblemStatistics& problem,
-                  JsonWriter* json) {
-  json->Key("pixels").BeginObject();
-  json->Field("active", problem.active_pixels);
-  json->Field("skipped", problem.skipped_pixels);
-  json->Field("activity_radius_px", options.activity_radius_px);
-  json->Field("merge_quiet_steps", options.merge_quiet_steps);
-  json->EndObject();
-  json->Key("problem").BeginObject();
-  json->Field("independent_parts", problem.parts);
-  json->Field("split_independent_parts", options.split_independent_parts);
-  json->Key("smoothing_continuation").BeginArray();
-  for (const double scale : options.smoothing_continuation) json->Element(scale);
-  json->EndArray();
-  json->Field("parameter_blocks", problem.parameter_blocks);
-  json->Field("unknowns", problem.variable_parameter_blocks);
-  json->Field("residual_blocks", problem.residual_blocks());
-  json->Field("frame_residuals", problem.frame_residuals);
-  json->Field("event_residuals", problem.event_residuals);
-  json->Field("spatial_tv_residuals", problem.spatial_tv_residuals);
-  json->Field("temporal_tv_residuals", problem.temporal_tv_residuals);
-  json->EndObject();
+void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& problem,
+                Json* summary) {
+  Json& json = *summary;
+  json["pixels"] = {
+      {"active", problem.active_pixels},
+      {"skipped", problem.skipped_pixels},
+      {"activity_radius_px", options.activity_radius_px},
+      {"merge_quiet_steps", options.merge_quiet_steps},
+  };
+  Json continuation = Json::array();
+  for (const double scale : options.smoothing_continuation) continuation.push_back(Number(scale));
+  json["problem"] = {
+      {"independent_parts", problem.parts},
+      {"split_independent_parts", options.split_independent_parts},
+      {"smoothing_continuation", continuation},
+      {"parameter_blocks", problem.parameter_blocks},
+      {"unknowns", problem.variable_parameter_blocks},
+      {"residual_blocks", problem.residual_blocks()},
+      {"frame_residuals", problem.frame_residuals},
+      {"event_residuals", problem.event_residuals},
+      {"spatial_tv_residuals", problem.spatial_tv_residuals},
+      {"temporal_tv_residuals", problem.temporal_tv_residuals},
+  };
 }
 
 }  // namespace
@@ -286,99 +291,82 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   const ReconstructionSummary& summary = run.reconstruction;
   const ReconstructionOptions& options = request.method.reconstruction;
   const bool iterative = IsIterative(request.method.method);
-  JsonWriter json;
-  json.BeginObject();
-  json.Field("mode", ModeName(result.mode));
-  json.Field("data", request.data_label.empty() ? request.data_path : request.data_label);
-  json.Field("width", result.width);
-  json.Field("height", result.height);
-  json.Field("events", result.events);
-  json.Field("hot_pixels", result.hot_pixels);
-  json.Field("hot_pixel_events", result.hot_pixel_events);
-  json.Field("event_frames", result.event_frames);
-  json.Field("latent_frames", run.video.num_frames());
-  json.Field("output_frames", result.output.num_frames());
-  json.Key("solver").BeginObject();
-  json.Field("name", run.method);
-  json.Field("message", run.message);
+  Json json;
+  json["mode"] = ModeName(result.mode);
+  json["data"] = request.data_label.empty() ? request.data_path : request.data_label;
+  json["width"] = result.width;
+  json["height"] = result.height;
+  json["events"] = result.events;
+  json["hot_pixels"] = result.hot_pixels;
+  json["hot_pixel_events"] = result.hot_pixel_events;
+  json["event_frames"] = result.event_frames;
+  json["latent_frames"] = run.video.num_frames();
+  json["output_frames"] = result.output.num_frames();
+  Json solver;
+  solver["name"] = run.method;
+  solver["message"] = run.message;
   if (iterative) {
-    json.Field("initialization", run.initialization);
-    json.Field("bounds", options.bound_intensities);
+    solver["initialization"] = run.initialization;
+    solver["bounds"] = options.bound_intensities;
   }
-  if (request.method.method == Method::kCeresLm) WriteCeresLm(options, summary, &json);
+  if (request.method.method == Method::kCeresLm) AddCeresLm(options, summary, &solver);
   if (!run.parameters.empty()) {
-    json.Key("parameters").BeginObject();
+    Json& parameters = solver["parameters"];
     for (const BaselineParameter& parameter : run.parameters) {
-      json.Field(parameter.name.c_str(), parameter.value);
+      parameters[parameter.name] = Number(parameter.value);
     }
-    json.EndObject();
   }
-  if (!run.threshold_source.empty()) json.Field("threshold_source", run.threshold_source);
-  json.EndObject();
+  if (!run.threshold_source.empty()) solver["threshold_source"] = run.threshold_source;
+  json["solver"] = std::move(solver);
   if (iterative) {
-    WriteModel(options.objective, summary, &json);
-    json.Field("solved", run.solved);
-    json.Field("iterations", run.iterations);
-    json.Field("initial_cost", run.initial_cost);
-    json.Field("final_cost", run.final_cost);
-    WriteProblem(options, summary.problem, &json);
+    json["model"] = ModelJson(options.objective, summary);
+    json["solved"] = run.solved;
+    json["iterations"] = run.iterations;
+    json["initial_cost"] = Number(run.initial_cost);
+    json["final_cost"] = Number(run.final_cost);
+    AddProblem(options, summary.problem, &json);
   }
-  json.Key("time_s").BeginObject();
-  json.Field("read", result.time.read_s);
-  json.Field("bin", result.time.bin_s);
-  json.Field("build", result.time.build_s);
-  json.Field("solve", result.time.solve_s);
-  json.Field("write", result.time.write_s);
-  json.Field("total", result.time.total_s);
-  json.EndObject();
+  json["time_s"] = {
+      {"read", Number(result.time.read_s)},   {"bin", Number(result.time.bin_s)},
+      {"build", Number(result.time.build_s)}, {"solve", Number(result.time.solve_s)},
+      {"write", Number(result.time.write_s)}, {"total", Number(result.time.total_s)},
+  };
   if (result.has_truth) {
     const TruthScore& truth = result.truth;
-    json.Key("truth").BeginObject();
-    json.Field("index", truth.index);
-    json.Field("timestamp_s", NanosecondsToSeconds(truth.timestamp_ns));
-    json.Field("latent_index", truth.latent_index);
-    json.Field("psnr", truth.psnr);
-    json.Field("ssim", truth.ssim);
-    json.Field("baseline", result.mode == Mode::kInterpolate ? "blend" : "copy");
-    json.Field("baseline_psnr", truth.baseline_psnr);
-    json.Field("baseline_ssim", truth.baseline_ssim);
-    json.EndObject();
+    json["truth"] = {
+        {"index", truth.index},
+        {"timestamp_s", NanosecondsToSeconds(truth.timestamp_ns)},
+        {"latent_index", truth.latent_index},
+        {"psnr", Number(truth.psnr)},
+        {"ssim", Number(truth.ssim)},
+        {"baseline", result.mode == Mode::kInterpolate ? "blend" : "copy"},
+        {"baseline_psnr", Number(truth.baseline_psnr)},
+        {"baseline_ssim", Number(truth.baseline_ssim)},
+    };
   }
   if (!run.checkpoints.empty()) {
-    json.Key("checkpoints").BeginArray();
+    Json& checkpoints = json["checkpoints"];
     for (const Checkpoint& checkpoint : run.checkpoints) {
-      json.BeginObject();
-      json.Field("iteration", checkpoint.iteration);
-      json.Field("time_s", checkpoint.time_s);
-      json.Field("cost", checkpoint.cost);
+      Json entry = {
+          {"iteration", checkpoint.iteration},
+          {"time_s", Number(checkpoint.time_s)},
+          {"cost", Number(checkpoint.cost)},
+      };
       if (result.has_truth) {
-        json.Field("psnr", checkpoint.psnr);
-        json.Field("ssim", checkpoint.ssim);
+        entry["psnr"] = Number(checkpoint.psnr);
+        entry["ssim"] = Number(checkpoint.ssim);
       }
-      json.EndObject();
+      checkpoints.push_back(std::move(entry));
     }
-    json.EndArray();
   }
-  json.EndObject();
-  return json.str();
+  return json.dump(2);
 }
 
 void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
                          const std::string& folder) {
   const auto write_start = Clock::now();
   const fs::path out(folder);
-  std::error_code ec;
-  fs::create_directories(out / "frames", ec);
-  if (ec) {
-    throw InputError(InputError::Kind::kUnwritable, out.string(), 0,
-                     "cannot create the output folder (" + ec.message() + ")");
-  }
-  char name[32];
-  for (int t = 0; t < result->output.num_frames(); ++t) {
-    std::snprintf(name, sizeof(name), "%06d.png", t);
-    WriteGreyPng16((out / "frames" / name).string(), result->output.frame(t));
-  }
-  WriteTimestampsTxt((out / "timestamps.txt").string(), result->output.timestamps_ns());
+  WriteFrameSequence(folder, result->output);
   result->time.write_s = SecondsSince(write_start);
   result->time.total_s += result->time.write_s;
   std::ofstream summary(out / "summary.json");

@@ -27,6 +27,8 @@
 #include "app/demo.h"
 #include "app/progress.h"
 #include "app/reconstruct_job.h"
+#include "app/reports.h"
+#include "app/simulate_job.h"
 #include "core/enum_names.h"
 #include "core/error.h"
 #include "core/time.h"
@@ -34,9 +36,7 @@
 #include "events/simulator.h"
 #include "io/aedat4.h"
 #include "io/data_source.h"
-#include "io/frame_list.h"
 #include "io/hdf5_io.h"
-#include "io/image_io.h"
 #include "io/output_target.h"
 #include "io/text_folder.h"
 #include "scene/scene.h"
@@ -225,88 +225,13 @@ BinningOptions BinningFromFlags() {
   return binning;
 }
 
-// The events between frames `first` and `last` (counts, polarities, the pixels that fired, the
-// collision frames, hot pixels), the binning a reconstruction would get with the same flags
-// (decided from counts: no frame is allocated), and the frames' change of mean brightness.
-void PrintWindow(const DataSource& source, int first, int last) {
-  const int64_t begin_ns = source.frames()[first].t_ns, end_ns = source.frames()[last].t_ns;
-  const EventStream window = source.ReadEvents(begin_ns, end_ns);
-  const BinningPlan plan = PlanBinning(window, begin_ns, end_ns, BinningFromFlags());
-  const PixelActivity& activity = plan.activity;
-  const size_t positive = window.CountPositive();
-  std::string hot;
-  if (!activity.hot_pixels.empty()) {
-    hot = " without " + std::to_string(activity.hot_pixels.size()) + " hot pixel" +
-          (activity.hot_pixels.size() == 1 ? "" : "s") + " (" +
-          std::to_string(activity.hot_pixel_events) + " events left out)";
-  }
-  std::printf(
-      "window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %lld pixels "
-      "(%.1f %%), %lld collision frames%s\n",
-      first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(), positive,
-      window.size() - positive, static_cast<long long>(activity.pixels_fired),
-      100.0 * static_cast<double>(activity.pixels_fired) / static_cast<double>(plan.pixels),
-      static_cast<long long>(plan.collision_frames), hot.c_str());
-  std::printf("binning     %s: %s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
-              FLAGS_binning.c_str(), NameOf(kBinningMethodNames, plan.method),
-              plan.num_event_frames, plan.num_latent_frames,
-              static_cast<long long>(plan.latent_voxels()),
-              static_cast<long long>(FLAGS_max_latent_voxels));
-  // A change of overall brightness between the frames (flicker, exposure or gain) that no
-  // event records is outside the per-pixel event model; this line shows it.
-  const double first_mean = source.ReadImage(first).mean();
-  const double last_mean = source.ReadImage(last).mean();
-  std::printf("brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", first, first_mean,
-              last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
-}
-
 int RunInfo() {
   Require(!FLAGS_data.empty(), "info needs --data=DIR or --data=FILE.h5");
   const auto source = DataSource::Open(FLAGS_data);
-  const EventSummary events = source->Summarize();
-  std::printf("data        %s\n", source->path().c_str());
-  std::printf("resolution  %dx%d\n", source->width(), source->height());
-  if (source->has_events()) {
-    std::printf("events      %lld (%lld ON, %lld OFF)\n", static_cast<long long>(events.count),
-                static_cast<long long>(events.positive),
-                static_cast<long long>(events.count - events.positive));
-  } else {
-    std::printf(
-        "events      none: frames only (make events with 'evfs simulate --frames=%s "
-        "--out=DIR')\n",
-        source->path().c_str());
-  }
-  if (events.count > 0) {
-    const double span_s = NanosecondsToSeconds(events.t_last_ns - events.t_first_ns);
-    std::printf("time span   %.6f s .. %.6f s (%.6f s)\n", NanosecondsToSeconds(events.t_first_ns),
-                NanosecondsToSeconds(events.t_last_ns), span_s);
-    if (span_s > 0) std::printf("event rate  %.3f Mev/s\n", events.count / span_s / 1e6);
-  }
-  const auto& frames = source->frames();
-  if (frames.empty()) {
-    std::printf("frames      0 (%s)\n", source->no_frames_reason().c_str());
-  } else {
-    std::printf("frames      %zu\n", frames.size());
-  }
-  for (size_t i = 0; i < frames.size(); ++i) {
-    std::printf("  %3zu  t=%.6f s  %s", i, NanosecondsToSeconds(frames[i].t_ns),
-                frames[i].path.c_str());
-    if (frames[i].has_exposure) {
-      std::printf(
-          "  exposure %.6f .. %.6f s (%.1f ms)", NanosecondsToSeconds(frames[i].exposure_begin_ns),
-          NanosecondsToSeconds(frames[i].exposure_end_ns),
-          1e3 * NanosecondsToSeconds(frames[i].exposure_end_ns - frames[i].exposure_begin_ns));
-    }
-    std::printf("\n");
-  }
+  PrintRecording(*source, stdout);
   if (FLAGS_first >= 0 && source->has_events()) {
-    const int count = static_cast<int>(frames.size());
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
-    Require(count > 0, source->path() + " has 0 frames (" + source->no_frames_reason() +
-                           "): --first/--last name frames");
-    Require(FLAGS_first < count && last < count && last > FLAGS_first,
-            "--first/--last must be frame indices with first < last < " + std::to_string(count));
-    PrintWindow(*source, FLAGS_first, last);
+    PrintWindow(*source, FLAGS_first, last, BinningFromFlags(), FLAGS_binning, stdout);
   }
   return 0;
 }
@@ -340,28 +265,11 @@ int RunSimulate() {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
   OutputTarget out(OutputFromFlags("simulate", FLAGS_frames));
-
-  const std::filesystem::path folder(FLAGS_frames);
-  std::vector<FrameInfo> frames = ReadFrameList((folder / "images.txt").string());
-  Require(frames.size() >= 2,
-          (folder / "images.txt").string() + ": simulate needs at least 2 frames");
-  Video video;
-  std::vector<Image> images;
-  for (const FrameInfo& frame : frames) {
-    images.push_back(ReadGreyImage((folder / frame.path).string()));
-    if (!video.empty() &&
-        (images.back().rows() != video.height() || images.back().cols() != video.width())) {
-      throw InputError(InputError::Kind::kSizeMismatch, (folder / frame.path).string(), 0,
-                       "expected a " + std::to_string(video.width()) + "x" +
-                           std::to_string(video.height()) + " image like the first frame");
-    }
-    video.AppendFrame(images.back(), frame.t_ns);
-  }
-  const EventStream events = SimulateEvents(video, options);
-  WriteDataFolder(out.staging(), events, frames, images);
+  const SimulateSummary summary = SimulateRecording(FLAGS_frames, options, out.staging());
   out.Commit();
-  std::printf("simulated %zu events over %zu frames (%dx%d) into %s\n", events.size(),
-              frames.size(), video.width(), video.height(), out.path().c_str());
+  std::printf("simulated %lld events over %d frames (%dx%d) into %s\n",
+              static_cast<long long>(summary.events), summary.frames, summary.width, summary.height,
+              out.path().c_str());
   return 0;
 }
 
@@ -458,39 +366,7 @@ int RunReconstruct(ProgressReporter* progress) {
   WriteReconstruction(request, &result, out.staging());
   out.Commit();
 
-  const MethodResult& run = result.run;
-  std::printf("%s: %dx%d, %lld events, %d event frames, %d latent frames\n", ModeName(result.mode),
-              result.width, result.height, static_cast<long long>(result.events),
-              result.event_frames, run.video.num_frames());
-  if (result.hot_pixels > 0) {
-    std::printf("hot pixels: %d, their %lld events left out (--hot_pixel_factor)\n",
-                result.hot_pixels, static_cast<long long>(result.hot_pixel_events));
-  }
-  if (IsIterative(request.method.method)) {
-    std::printf("model: %s\n", run.reconstruction.model.description.c_str());
-    if (run.solved) {
-      std::printf("solve: %s from %s, %d iterations, cost %.6g -> %.6g (%s)\n", run.method.c_str(),
-                  run.initialization.c_str(), run.iterations, run.initial_cost, run.final_cost,
-                  run.message.c_str());
-    } else {
-      std::printf("solve: skipped (%s)\n", run.message.c_str());
-    }
-  } else {
-    std::printf("method: %s%s%s\n", run.method.c_str(), run.threshold_source.empty() ? "" : ", ",
-                run.threshold_source.c_str());
-  }
-  if (result.has_truth) {
-    std::printf("truth: frame %d vs latent %d: PSNR %.2f dB, SSIM %.4f (%s: %.2f dB, %.4f)\n",
-                result.truth.index, result.truth.latent_index, result.truth.psnr, result.truth.ssim,
-                result.mode == Mode::kInterpolate ? "blend" : "copy", result.truth.baseline_psnr,
-                result.truth.baseline_ssim);
-  }
-  std::printf(
-      "time: read %.2f s, bin %.3f s, build %.2f s, solve %.2f s, write %.2f s, "
-      "total %.2f s\n",
-      result.time.read_s, result.time.bin_s, result.time.build_s, result.time.solve_s,
-      result.time.write_s, result.time.total_s);
-  std::printf("wrote %d frames to %s\n", result.output.num_frames(), out.path().c_str());
+  PrintReconstruction(request, result, out.path(), stdout);
   return 0;
 }
 

@@ -1,6 +1,7 @@
 #include "io/image_io.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -112,6 +113,23 @@ void WriteTimestampsTxt(const std::string& path, const std::vector<int64_t>& t_n
                  '\n');
   }
   writer.Close();
+}
+
+void WriteFrameSequence(const std::string& folder, const Video& video) {
+  const std::filesystem::path frames = std::filesystem::path(folder) / "frames";
+  std::error_code error;
+  std::filesystem::create_directories(frames, error);
+  if (error) {
+    throw InputError(InputError::Kind::kUnwritable, frames.string(), 0,
+                     "cannot create the folder (" + error.message() + ")");
+  }
+  char name[32];
+  for (int t = 0; t < video.num_frames(); ++t) {
+    std::snprintf(name, sizeof(name), "%06d.png", t);
+    WriteGreyPng16((frames / name).string(), video.frame(t));
+  }
+  WriteTimestampsTxt((std::filesystem::path(folder) / "timestamps.txt").string(),
+                     video.timestamps_ns());
 }
 
 }  // namespace evfs

@@ -35,6 +35,11 @@ void WriteGreyPngLossless(const std::string& path, const Image& image);
 /// Throws InputError(kUnwritable).
 void WriteTimestampsTxt(const std::string& path, const std::vector<int64_t>& t_ns);
 
+/// Writes `video` as a frame sequence in `folder` (created when missing): frames/NNNNNN.png
+/// (16-bit, WriteGreyPng16; NNNNNN the 0-based frame index) and timestamps.txt
+/// (WriteTimestampsTxt). Throws InputError(kUnwritable).
+void WriteFrameSequence(const std::string& folder, const Video& video);
+
 }  // namespace evfs
 
 #endif  // EVFS_IO_IMAGE_IO_H_

@@ -3,7 +3,6 @@
 // flag that overflows arithmetic) makes of `evfs`. Each case is small enough to run in well
 // under a second, yet failed (allocated gigabytes, looped, crashed) before the fix.
 #include <gtest/gtest.h>
-#include <hdf5.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "io/hdf5_io.h"
 #include "io/text_folder.h"
 #include "tests/examples/cli_test_util.h"
+#include "tests/io/hdf5_test_util.h"
 #include "tests/test_data.h"
 
 namespace evfs {
@@ -24,6 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::CommandResult;
+using test::DeclareSensorResolution;
 using test::ExpectUserError;
 using test::ReadFile;
 using test::RunEvfs;
@@ -142,22 +143,6 @@ TEST(EvfsLimits, ExplicitBinningBeyondTheVoxelCapIsAUserError) {
       RunLimited("reconstruct --data=" + data +
                  " --mode=predict --first=0 --last=4 --max_latent_voxels=2000 --out=" + out),
       "needs at least 2 latent frames", out);
-}
-
-// Rewrites the root attribute sensor_resolution of an HDF5 file as [height, width].
-void DeclareSensorResolution(const std::string& path, int64_t height, int64_t width) {
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  ASSERT_GE(file, 0) << path;
-  if (H5Aexists(file, "sensor_resolution") > 0) H5Adelete(file, "sensor_resolution");
-  const hsize_t two = 2;
-  const int64_t resolution[2] = {height, width};
-  const hid_t space = H5Screate_simple(1, &two, nullptr);
-  const hid_t attribute =
-      H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
-  H5Awrite(attribute, H5T_NATIVE_INT64, resolution);
-  H5Aclose(attribute);
-  H5Sclose(space);
-  H5Fclose(file);
 }
 
 // Regression (issue 14): a sensor_resolution of 65535x65535 made `info --first --last` allocate

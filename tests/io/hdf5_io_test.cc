@@ -8,11 +8,14 @@
 #include <thread>
 #include <vector>
 
+#include "tests/io/hdf5_test_util.h"
 #include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace evfs {
 namespace {
+
+using test::DeclareSensorResolution;
 
 constexpr int kWidth = 64;
 constexpr int kHeight = 48;
@@ -472,21 +475,6 @@ TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
   const std::string later = with_huge_image("later.h5", "images/image000000001");
   test::ExpectInputError([&] { Hdf5DataSource source(later); }, InputError::Kind::kSizeMismatch,
                          "images/image000000001 is 64x4294967344", 0);
-}
-
-// Rewrites the root attribute sensor_resolution of `path` as [height, width].
-void DeclareSensorResolution(const std::string& path, int64_t height, int64_t width) {
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  if (H5Aexists(file, "sensor_resolution") > 0) H5Adelete(file, "sensor_resolution");
-  const hsize_t two = 2;
-  const int64_t resolution[2] = {height, width};
-  const hid_t space = H5Screate_simple(1, &two, nullptr);
-  const hid_t attribute =
-      H5Acreate2(file, "sensor_resolution", H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
-  H5Awrite(attribute, H5T_NATIVE_INT64, resolution);
-  H5Aclose(attribute);
-  H5Sclose(space);
-  H5Fclose(file);
 }
 
 // Regression (issue 14): a sensor_resolution of 65535x65535 over 64x48 frames was trusted until

@@ -1,0 +1,43 @@
+#include "app/simulate_job.h"
+
+#include <memory>
+#include <vector>
+
+#include "core/error.h"
+#include "core/video.h"
+#include "io/data_source.h"
+#include "io/text_folder.h"
+
+namespace evfs {
+
+SimulateSummary SimulateRecording(const std::string& frames_path, const SimulatorOptions& options,
+                                  const std::string& out_folder) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
+  const std::unique_ptr<DataSource> source = DataSource::Open(frames_path);
+  const std::vector<FrameInfo>& frames = source->frames();
+  if (frames.size() < 2) {
+    std::string reason = std::to_string(frames.size()) + " found";
+    if (!source->no_frames_reason().empty()) reason += ": " + source->no_frames_reason();
+    throw InputError(InputError::Kind::kMalformed, source->path(), 0,
+                     "simulate needs at least 2 frames (" + reason + ")");
+  }
+  Video video;
+  std::vector<Image> images;
+  images.reserve(frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    images.push_back(source->ReadImage(static_cast<int>(i)));
+    video.AppendFrame(images.back(), frames[i].t_ns);
+  }
+  const EventStream events = SimulateEvents(video, options);
+  WriteDataFolder(out_folder, events, frames, images);
+
+  SimulateSummary summary;
+  summary.events = static_cast<int64_t>(events.size());
+  summary.frames = static_cast<int>(frames.size());
+  summary.width = video.width();
+  summary.height = video.height();
+  return summary;
+}
+
+}  // namespace evfs

@@ -1,0 +1,28 @@
+// `evfs simulate`: the frames of a recording (a folder in the text layout, typically with
+// images.txt only, or any file DataSource opens) through the event simulator, written as a
+// data folder with the same frames and the simulated events.
+#ifndef EVFS_APP_SIMULATE_JOB_H_
+#define EVFS_APP_SIMULATE_JOB_H_
+
+#include <cstdint>
+#include <string>
+
+#include "events/simulator.h"
+
+namespace evfs {
+
+struct SimulateSummary {
+  int64_t events = 0;
+  int frames = 0;
+  int width = 0, height = 0;
+};
+
+/// Reads every frame of `frames_path` (at least 2), simulates events with `options` and writes
+/// the data folder `out_folder` (io/text_folder.h's WriteDataFolder). Throws
+/// InvalidArgumentError for invalid options, InputError for unreadable or inconsistent frames.
+SimulateSummary SimulateRecording(const std::string& frames_path, const SimulatorOptions& options,
+                                  const std::string& out_folder);
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_SIMULATE_JOB_H_
