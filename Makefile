@@ -3,7 +3,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build run test test-sanitize bench clean fuzz
+.PHONY: all deps build run test test-sanitize bench clean fuzz train-denoiser install python
 
 all: build
 
@@ -17,6 +17,13 @@ build: deps
 # The main job: a synthetic scene through the whole pipeline, results in out/demo.
 run: build
 	./$(BUILD_DIR)/examples/evfs demo --out=out/demo --overwrite
+
+# The Python module evfs (python/, pybind11) into $(BUILD_DIR)/python, for Debian's python3.
+python: deps
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DEVFS_BUILD_PYTHON=ON $(CMAKE_FLAGS) > /dev/null
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target evfs_python
+	@echo "built $$(ls $(BUILD_DIR)/python/evfs*.so); use it with:"
+	@echo "  PYTHONPATH=$(BUILD_DIR)/python /usr/bin/python3 -c 'import evfs; help(evfs)'"
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -49,6 +56,21 @@ fuzz:
 	    -print_final_stats=1 -artifact_prefix=$(FUZZ_DIR)/findings/$$name- \
 	    $(FUZZ_DIR)/corpus/$$name $(FUZZ_DIR)/seeds/$$name || exit 1; \
 	done
+
+# Trains the residual denoiser from scratch (about an hour on 2 cores): pairs made by evfs's own
+# simulator and DMR, then tools/train_denoiser/train.py; writes models/evfs_denoiser.onnx,
+# models/training_log.md and the C++ equality test's reference in tests/denoiser/data.
+train-denoiser:
+	@bash scripts/install-deps.sh
+	@bash scripts/install-deps.sh --train
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) > /dev/null
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target make_denoiser_pairs
+	bash tools/train_denoiser/train.sh $(BUILD_DIR)
+
+# The CMake package, the evfs program and the headers into PREFIX (README.md, "Use from CMake").
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
 
 bench: build
 	bash benchmarks/run_all.sh $(BUILD_DIR)

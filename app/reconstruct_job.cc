@@ -95,7 +95,11 @@ Mode ParseMode(const std::string& name) {
 
 const char* ModeName(Mode mode) { return NameOf(kModeNames, mode); }
 
-ReconstructResult RunReconstruction(const ReconstructRequest& request) {
+namespace {
+
+// The job, reading `given` or, when it is null, the recording at request.data_path.
+ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
+                                        const DataSource* given) {
   const auto total_start = Clock::now();
   std::string error;
   if (!request.method.reconstruction.IsValid(&error)) {
@@ -110,6 +114,13 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
                                std::to_string(static_cast<int>(kMaxExposureS)) + " seconds");
   }
 
+  CheckDenoiseMode(request.denoise.mode, request.method.method);
+  if (request.denoise.mode == DenoiseMode::kPnp && !request.denoise.pnp.IsValid(&error)) {
+    throw InvalidArgumentError("invalid plug & play options: " + error);
+  }
+  // Loaded before any input is read: a bad weights file fails in milliseconds, not after a solve.
+  const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request.denoise);
+
   ReconstructResult result;
   result.mode = request.mode;
   const auto stage = [&request](const char* name) {
@@ -117,7 +128,9 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   };
   stage("read");
   const auto read_start = Clock::now();
-  const std::unique_ptr<DataSource> source = DataSource::Open(request.data_path);
+  std::unique_ptr<DataSource> opened;
+  if (given == nullptr) opened = DataSource::Open(request.data_path);
+  const DataSource* source = given != nullptr ? given : opened.get();
   result.width = source->width();
   result.height = source->height();
   CheckFrameIndex(*source, request.first, "the first");
@@ -192,6 +205,19 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
                          score ? &checkpoint_truth : nullptr);
   result.time.build_s = result.run.build_time_s;
   result.time.solve_s = result.run.solve_time_s;
+  if (denoiser != nullptr) {
+    stage("denoise");
+    const int truth_latent = score ? result.run.video.NearestFrame(result.truth.timestamp_ns) : -1;
+    const DenoiseRegion region = SolvedRegion(scene, request.method, result.run.solved);
+    const Image* truth = score ? &truth_image : nullptr;
+    if (request.denoise.mode == DenoiseMode::kPnp) {
+      result.denoise = PlugAndPlayLatentVideo(*denoiser, scene, request.method, request.denoise.pnp,
+                                              region, truth, truth_latent, &result.run);
+    } else {
+      result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region, truth,
+                                          truth_latent, &result.run.video);
+    }
+  }
   const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
 
@@ -209,6 +235,16 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request) {
   }
   result.time.total_s = SecondsSince(total_start);
   return result;
+}
+
+}  // namespace
+
+ReconstructResult RunReconstruction(const ReconstructRequest& request) {
+  return RunReconstructionFrom(request, nullptr);
+}
+
+ReconstructResult RunReconstruction(const ReconstructRequest& request, const DataSource& source) {
+  return RunReconstructionFrom(request, &source);
 }
 
 namespace {
@@ -331,6 +367,7 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
       {"build", Number(result.time.build_s)}, {"solve", Number(result.time.solve_s)},
       {"write", Number(result.time.write_s)}, {"total", Number(result.time.total_s)},
   };
+  json["denoiser"] = DenoiseJson(result.denoise);
   if (result.has_truth) {
     const TruthScore& truth = result.truth;
     json["truth"] = {

@@ -8,9 +8,11 @@
 #include <functional>
 #include <string>
 
+#include "app/denoise_job.h"
 #include "app/method.h"
 #include "core/enum_names.h"
 #include "core/video.h"
+#include "io/data_source.h"
 #include "scene/scene.h"
 
 namespace evfs {
@@ -42,6 +44,8 @@ struct ReconstructRequest {
   MethodOptions method;
   /// Record cost (and PSNR/SSIM against --truth) at every iteration into summary.json.
   bool checkpoints = false;
+  /// The residual denoiser after the solve (DenoiseMode::kNone: none).
+  DenoiseRequest denoise;
   /// Sees every iteration of an iterative method (progress output); may be empty.
   IterationCallback progress;
   /// Told each stage as the job reaches it: "read", "bin", then "build" (with `progress`: the
@@ -74,10 +78,14 @@ struct ReconstructResult {
   bool has_truth = false;
   TruthScore truth;
   StageTimes time;
+  DenoiseRecord denoise;  // what the denoiser did (mode none: nothing)
 };
 
 /// Runs the job. Throws evfs::Error (InputError, InvalidArgumentError) on bad input.
 ReconstructResult RunReconstruction(const ReconstructRequest& request);
+/// The same job on a recording already open (or held in memory, as the Python module's arrays
+/// are): `source` replaces request.data_path, which is not read.
+ReconstructResult RunReconstruction(const ReconstructRequest& request, const DataSource& source);
 
 /// Writes `folder`/frames/NNNNNN.png (16-bit grey), timestamps.txt and summary.json into a new
 /// or empty folder: the staging folder of an OutputTarget (io/output_target.h), which makes the

@@ -1,4 +1,7 @@
 include("${CMAKE_CURRENT_LIST_DIR}/EvfsLayers.cmake")
+include(GNUInstallDirs)
+# Installed headers keep their module folders under one evfs folder: #include "solver/…".
+set(EVFS_INSTALL_INCLUDEDIR "${CMAKE_INSTALL_INCLUDEDIR}/evfs")
 evfs_read_layers("${PROJECT_SOURCE_DIR}/cmake/layers.txt" EVFS_MODULES)
 
 # evfs_module_include_dir(MODULE OUT_VAR)
@@ -26,21 +29,38 @@ function(evfs_current_module out_var)
   set(${out_var} "${module}" PARENT_SCOPE)
 endfunction()
 
-# evfs_add_library(NAME SRCS a.cc ... DEPS lib ...)
+# evfs_add_library(NAME [INTERNAL] SRCS a.cc ... DEPS lib ...)
 #   One static library per module folder (INTERFACE when SRCS holds no source), seeing only the
-#   modules it may use (evfs_module_include_dir).
+#   modules it may use (evfs_module_include_dir). Unless INTERNAL (a helper of the benchmarks or
+#   tools), it is installed with the module's headers (include/evfs/MODULE/*.h) and exported as
+#   evfs::MODULE (evfs_solver → evfs::solver) by cmake/EvfsPackage.cmake; installed, its headers
+#   are found under include/evfs.
 function(evfs_add_library name)
-  cmake_parse_arguments(ARG "" "" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "INTERNAL" "" "SRCS;DEPS" ${ARGN})
   evfs_current_module(module)
   evfs_module_include_dir(${module} include_dir)
+  set(include_dirs "$<BUILD_INTERFACE:${include_dir}>"
+                   "$<INSTALL_INTERFACE:${EVFS_INSTALL_INCLUDEDIR}>")
   if(ARG_SRCS)
     add_library(${name} STATIC ${ARG_SRCS})
-    target_include_directories(${name} PUBLIC "${include_dir}")
+    target_include_directories(${name} PUBLIC ${include_dirs})
     target_link_libraries(${name} PUBLIC ${ARG_DEPS})
   else()
     add_library(${name} INTERFACE)
-    target_include_directories(${name} INTERFACE "${include_dir}")
+    target_include_directories(${name} INTERFACE ${include_dirs})
     target_link_libraries(${name} INTERFACE ${ARG_DEPS})
+  endif()
+  if(ARG_INTERNAL)
+    return()
+  endif()
+  string(REGEX REPLACE "^evfs_" "" export_name "${name}")
+  set_target_properties(${name} PROPERTIES EXPORT_NAME ${export_name})
+  install(TARGETS ${name} EXPORT evfsTargets
+          ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
+          LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}")
+  file(GLOB headers CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.h")
+  if(headers)
+    install(FILES ${headers} DESTINATION "${EVFS_INSTALL_INCLUDEDIR}/${module}")
   endif()
 endfunction()
 

@@ -3,6 +3,9 @@
 //   evfs info        --data=DIR [--first=I --last=J]
 //   evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]
 //                    [--truth=K] --out=OUT [solver and model flags]
+//   evfs video       --data=DIR --out=OUT [--fps=N --first=I --last=J --jobs=N --resume
+//                    --preview] [solver and model flags]
+//   evfs denoise     --in=RECONSTRUCTION_DIR --out=DIR [--denoiser=FILE.onnx]
 //   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
 //   evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR
 //   evfs demo        --out=DIR
@@ -13,6 +16,7 @@
 #include <glog/logging.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -25,13 +29,18 @@
 #include "app/allocator_tuning.h"
 #include "app/crash_guard.h"
 #include "app/demo.h"
+#include "app/denoise_job.h"
+#include "app/evfs_help.h"
 #include "app/progress.h"
 #include "app/reconstruct_job.h"
 #include "app/reports.h"
 #include "app/simulate_job.h"
+#include "app/version_report.h"
+#include "app/video_job.h"
 #include "core/enum_names.h"
 #include "core/error.h"
 #include "core/time.h"
+#include "core/version.h"
 #include "events/binning.h"
 #include "events/simulator.h"
 #include "io/aedat4.h"
@@ -164,9 +173,40 @@ DEFINE_int32(threads, evfs::DefaultSolverOptions().num_threads,
 DEFINE_bool(progress, false,
             "Print a line per solver iteration even when stderr is not a "
             "terminal (it slows a solve split into independent parts).");
+// The residual denoiser (paper §3.4).
+DEFINE_string(denoise, "auto",
+              "reconstruct: none | once (the residual denoiser after the solve) | pnp (plug & "
+              "play: ADMM between the Ceres problem and the denoiser, ceres_lm only) | auto "
+              "(once when --denoiser is given; with the shipped weights the mode that measured "
+              "best, BENCHMARKS.md: none while no mode beats the solve alone).");
+DEFINE_string(denoiser, "",
+              "The denoiser's ONNX weights (reconstruct, denoise); empty: the shipped "
+              "models/evfs_denoiser.onnx.");
+DEFINE_string(in, "", "denoise: the reconstruction folder (written by evfs reconstruct).");
 DEFINE_double(progress_interval_s, 5.0,
               "While a command runs, a line on stderr (stage, "
               "iteration, elapsed time) every this many seconds, terminal or not; 0: none.");
+// Video (evfs video).
+DEFINE_int32(jobs, 0, "video: windows solved at once; 0: every core.");
+DEFINE_bool(resume, false,
+            "video: reuse the windows an interrupted run of the same command finished (kept in "
+            ".OUT.evfs-video-work beside OUT).");
+DEFINE_bool(preview, false,
+            "video: also preview.mp4, side by side: last observed frame | reconstruction | the "
+            "step's events (red ON, blue OFF).");
+DEFINE_bool(predict_tail, true,
+            "video: predict after the recording's last frame up to the last event.");
+DEFINE_double(predict_max_s, 0.0,
+              "video: longest prediction after the last frame, seconds; 0: the median gap "
+              "between observed frames.");
+DEFINE_double(min_blur_exposure_s, 0.0,
+              "video: a frame whose exposure is at least this long is deblurred (observed over "
+              "its exposure); 0: every frame with a known exposure.");
+DEFINE_int32(frame_step, 1,
+             "video: observe every N-th frame and score the frames between (ground truth); 1: "
+             "every frame.");
+DEFINE_bool(skip_bad_frames, false,
+            "video: leave out missing or unreadable frames and reconstruct across the gap.");
 // Simulator.
 DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos,
               "simulate: ON contrast threshold (log intensity).");
@@ -181,24 +221,6 @@ DEFINE_uint64(seed, evfs::SimulatorOptions().seed, "simulate: random seed.");
 
 namespace evfs {
 namespace {
-
-constexpr char kUsage[] =
-    "event-driven video frame synthesis.\n\n"
-    "usage:\n"
-    "  evfs info        --data=DIR [--first=I --last=J]\n"
-    "  evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]\n"
-    "                   [--truth=K] --out=OUT [--fps=N] [solver and model flags]\n"
-    "  evfs simulate    --frames=DIR --out=DIR [--threshold_pos=0.2 --threshold_neg=0.2 "
-    "--seed=42]\n"
-    "  evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR\n"
-    "  evfs demo        --out=DIR\n\n"
-    "DIR is a folder in the Event Camera Dataset layout (events.txt 't x y p', images.txt\n"
-    "'t path', images/, optional exposures.txt 'path t_start t_end'), an .h5 file or an\n"
-    ".aedat4 recording (iniVation DV: events and frames).\n"
-    "I, J, K are 0-based lines of images.txt. Example:\n"
-    "  evfs reconstruct --data=../shared/data/slider_depth_70_71 --mode=predict --first=0 "
-    "--last=1 --truth=1 --out=out/slider\n"
-    "Run 'evfs --helpon=evfs_main' for every flag.";
 
 void Require(bool condition, const std::string& message) {
   if (!condition) throw InvalidArgumentError(message);
@@ -294,10 +316,11 @@ std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
   return numbers;
 }
 
-ReconstructRequest RequestFromFlags() {
+// The request of the reconstruct flags; `with_mode` false for `video`, which has no --mode.
+ReconstructRequest RequestFromFlags(bool with_mode = true) {
   ReconstructRequest request;
   request.data_path = FLAGS_data;
-  request.mode = ParseMode(FLAGS_mode);
+  if (with_mode) request.mode = ParseMode(FLAGS_mode);
   request.first = FLAGS_first;
   request.last = FLAGS_last;
   request.truth = FLAGS_truth;
@@ -348,7 +371,29 @@ ReconstructRequest RequestFromFlags() {
   solver.function_tolerance = FLAGS_function_tolerance;
   solver.max_num_line_search_step_size_iterations = FLAGS_bounds_line_search_iterations;
   solver.num_threads = FLAGS_threads;
+
+  request.denoise.denoiser.weights_path = FLAGS_denoiser;
+  if (FLAGS_denoise == "auto") {
+    request.denoise.mode = AutoDenoiseMode(FLAGS_denoiser);
+  } else {
+    request.denoise.mode = ParseName(kDenoiseModeNames, FLAGS_denoise, "--denoise");
+  }
   return request;
+}
+
+int RunDenoise() {
+  Require(!FLAGS_in.empty(), "denoise needs --in=RECONSTRUCTION_DIR");
+  Require(!FLAGS_out.empty(), "denoise needs --out=DIR");
+  DenoiseRequest request;
+  request.mode = DenoiseMode::kOnce;
+  request.denoiser.weights_path = FLAGS_denoiser;
+  OutputTarget out(OutputFromFlags("denoise", FLAGS_in));
+  const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request);
+  const DenoiseRecord record = DenoiseReconstructionFolder(FLAGS_in, *denoiser, out.staging());
+  out.Commit();
+  std::printf("denoised %d frames with %s in %.3f s into %s\n", record.stats.frames,
+              record.weights_path.c_str(), record.stats.time_s, out.path().c_str());
+  return 0;
 }
 
 int RunReconstruct(ProgressReporter* progress) {
@@ -370,6 +415,89 @@ int RunReconstruct(ProgressReporter* progress) {
   return 0;
 }
 
+// Every flag that decides `evfs video`'s output, for --resume to check: all of evfs' own
+// flags but those that only say where, how fast or how verbosely.
+std::string VideoSettings() {
+  static const char* const kNotSettings[] = {
+      "out", "overwrite", "resume", "jobs", "threads", "progress", "progress_interval_s"};
+  std::string settings;
+  std::vector<gflags::CommandLineFlagInfo> flags;
+  gflags::GetAllFlags(&flags);
+  for (const gflags::CommandLineFlagInfo& flag : flags) {
+    if (flag.filename.find("evfs_main.cc") == std::string::npos) continue;
+    if (std::find(std::begin(kNotSettings), std::end(kNotSettings), flag.name) !=
+        std::end(kNotSettings)) {
+      continue;
+    }
+    settings += flag.name + "=" + flag.current_value + " ";
+  }
+  return settings;
+}
+
+int RunVideoCommand(ProgressReporter* progress) {
+  Require(!FLAGS_data.empty(), "video needs --data=DIR or --data=FILE.h5");
+  Require(!FLAGS_out.empty(), "video needs --out=DIR");
+  Require(FLAGS_first >= -1 && FLAGS_last >= -1, "--first and --last must be frame numbers");
+  const ReconstructRequest reconstruct = RequestFromFlags(/*with_mode=*/false);
+  VideoRequest request;
+  request.data_path = FLAGS_data;
+  request.windows.first = std::max(FLAGS_first, 0);
+  request.windows.last = FLAGS_last;
+  request.windows.predict_tail = FLAGS_predict_tail;
+  request.windows.predict_max_s = FLAGS_predict_max_s;
+  request.windows.min_blur_exposure_s = FLAGS_min_blur_exposure_s;
+  request.windows.exposure_s = FLAGS_exposure_s;
+  request.windows.frame_step = FLAGS_frame_step;
+  request.fps = FLAGS_fps;
+  request.jobs = FLAGS_jobs;
+  // --threads given: every window's solve uses it; otherwise the cores left by --jobs.
+  gflags::CommandLineFlagInfo threads;
+  gflags::GetCommandLineFlagInfo("threads", &threads);
+  request.threads_per_window = threads.is_default ? 0 : FLAGS_threads;
+  request.skip_bad_frames = FLAGS_skip_bad_frames;
+  request.resume = FLAGS_resume;
+  request.preview = FLAGS_preview;
+  request.binning = reconstruct.binning;
+  request.method = reconstruct.method;
+  request.denoise = reconstruct.denoise;
+  request.settings = VideoSettings();
+  std::string error;
+  if (!request.IsValid(&error)) throw InvalidArgumentError(error);
+  OutputTarget out(OutputFromFlags("video", FLAGS_data));
+  const bool terminal = ::isatty(STDERR_FILENO);
+  request.progress = [progress, terminal](const VideoProgress& state) {
+    const std::string line = VideoProgressLine(state);
+    if (terminal) {
+      std::fprintf(stderr, "\r%s", line.c_str());
+      if (state.windows_done == state.windows_total) std::fputc('\n', stderr);
+    } else {
+      progress->StartStage(line);
+    }
+  };
+  progress->StartStage("windows");
+  const VideoResult result = RunVideo(request, out.path(), out.staging());
+  out.Commit();
+  RemoveVideoWorkFolder(out.path());
+  for (const int frame : result.skipped_frames) {
+    std::fprintf(stderr, "evfs video: left out unreadable frame %d\n", frame);
+  }
+  std::printf(
+      "%d windows (%d resumed), %lld events, %lld frames at %g fps (%dx%d) into %s\n"
+      "%.2f windows/s, %.0f events/s with %d jobs x %d threads; video.mp4 codec %s\n",
+      result.windows, result.windows_resumed, static_cast<long long>(result.events),
+      static_cast<long long>(result.output_frames), result.fps, result.width, result.height,
+      out.path().c_str(), result.windows_per_s, result.events_per_s, result.jobs,
+      result.threads_per_window, result.codec.c_str());
+  if (result.truth_frames > 0) {
+    std::printf(
+        "%d withheld frames: PSNR mean %.2f dB (worst %.2f, blend %.2f), SSIM mean %.4f "
+        "(worst %.4f, blend %.4f)\n",
+        result.truth_frames, result.mean_psnr, result.worst_psnr, result.mean_blend_psnr,
+        result.mean_ssim, result.worst_ssim, result.mean_blend_ssim);
+  }
+  return 0;
+}
+
 int RunCommand(const std::string& command) {
   Require(std::isfinite(FLAGS_progress_interval_s) && FLAGS_progress_interval_s >= 0.0,
           "--progress_interval_s must be a number of seconds, 0 or more");
@@ -381,8 +509,10 @@ int RunCommand(const std::string& command) {
   ProgressReporter progress(progress_options);
   if (command == "info") return RunInfo();
   if (command == "reconstruct") return RunReconstruct(&progress);
+  if (command == "video") return RunVideoCommand(&progress);
   if (command == "simulate") return RunSimulate();
   if (command == "convert") return RunConvert();
+  if (command == "denoise") return RunDenoise();
   if (command == "demo") {
     Require(!FLAGS_out.empty(), "demo needs --out=DIR");
     OutputTarget out(OutputFromFlags("demo", ""));
@@ -391,9 +521,10 @@ int RunCommand(const std::string& command) {
     std::printf("results written to %s\n", out.path().c_str());
     return status;
   }
-  throw InvalidArgumentError("unknown command '" + command +
-                             "': expected info, reconstruct, simulate, convert or demo "
-                             "(evfs --help)");
+  throw InvalidArgumentError(
+      "unknown command '" + command +
+      "': expected info, reconstruct, video, denoise, simulate, convert or demo "
+      "(evfs --help)");
 }
 
 // What a value of a flag of gflags type `type` must look like.
@@ -462,18 +593,21 @@ std::string FlagValue(const char* name) {
   return value;
 }
 
-// gflags' help flags print and then exit with status 1; help asked for is a success. Prints
-// what gflags would and returns true when one was given.
-bool ShowHelpAskedFor(const char* argv0) {
-  if (FlagValue("help") == "true" || FlagValue("helpfull") == "true" ||
-      FlagValue("helppackage") == "true") {
-    gflags::ShowUsageWithFlags(argv0);
-  } else if (FlagValue("helpshort") == "true") {
-    gflags::ShowUsageWithFlagsRestrict(argv0, "evfs_main");
+// gflags' help flags print and then exit with status 1; help asked for is a success. --help
+// and --helpshort show evfs' own flags by group (app/evfs_help.h), only the command's when one
+// is given; --helpfull shows every flag, glog's and gflags' too, as gflags does. Returns true
+// when help was asked for and printed; throws InvalidArgumentError for an unknown command.
+bool ShowHelpAskedFor(int argc, char** argv) {
+  if (FlagValue("help") == "true" || FlagValue("helpshort") == "true") {
+    const std::string text =
+        argc >= 2 ? CommandHelpText(EvfsHelp(), argv[1]) : ProgramHelpText(EvfsHelp());
+    std::fputs(text.c_str(), stdout);
+  } else if (FlagValue("helpfull") == "true" || FlagValue("helppackage") == "true") {
+    gflags::ShowUsageWithFlags(argv[0]);
   } else if (!FlagValue("helpon").empty()) {
-    gflags::ShowUsageWithFlagsRestrict(argv0, ("/" + FlagValue("helpon") + ".").c_str());
+    gflags::ShowUsageWithFlagsRestrict(argv[0], ("/" + FlagValue("helpon") + ".").c_str());
   } else if (!FlagValue("helpmatch").empty()) {
-    gflags::ShowUsageWithFlagsRestrict(argv0, FlagValue("helpmatch").c_str());
+    gflags::ShowUsageWithFlagsRestrict(argv[0], FlagValue("helpmatch").c_str());
   } else {
     return false;
   }
@@ -485,8 +619,9 @@ bool ShowHelpAskedFor(const char* argv0) {
 
 int main(int argc, char** argv) {
   evfs::KeepFreedMemoryForReuse();
-  gflags::SetUsageMessage(evfs::kUsage);
-  gflags::SetVersionString("0.1.0");
+  gflags::SetUsageMessage(evfs::EvfsHelp().summary + "\n\n" + evfs::UsageLines(evfs::EvfsHelp()) +
+                          "\nRun 'evfs --help' for evfs' own flags by group.");
+  gflags::SetVersionString(evfs::kVersion);
   // Libraries' log messages (Ceres' dump of a residual block it could not evaluate, its
   // "Terminating: ...") are for developers: shown with --minloglevel=0. What failed is evfs'
   // own one line.
@@ -498,8 +633,17 @@ int main(int argc, char** argv) {
     return evfs::kExitUserError;
   }
   gflags::ParseCommandLineNonHelpFlags(&argc, &argv, true);
-  if (evfs::ShowHelpAskedFor(argv[0])) return evfs::kExitSuccess;
-  gflags::HandleCommandLineHelpFlags();  // --version (status 0), --helpxml (status 1)
+  try {
+    if (evfs::ShowHelpAskedFor(argc, argv)) return evfs::kExitSuccess;
+  } catch (const evfs::Error& error) {
+    std::fprintf(stderr, "evfs: %s\n", error.what());
+    return evfs::kExitUserError;
+  }
+  if (evfs::FlagValue("version") == "true") {
+    std::fputs(evfs::VersionReport().c_str(), stdout);
+    return evfs::kExitSuccess;
+  }
+  gflags::HandleCommandLineHelpFlags();  // --helpxml (status 1)
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   if (argc != 2) {

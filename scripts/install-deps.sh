@@ -2,6 +2,8 @@
 # Installs the Debian packages evfs needs to build, test and benchmark.
 # Idempotent: when everything is present it only runs dpkg-query and exits.
 # With --fuzz it also installs clang and its libFuzzer runtime (for `make fuzz` only).
+# With --train it also installs what training the residual denoiser needs (`make train-denoiser`
+# only): PyTorch, ONNX, OpenCV's Python module, and the images and videos it trains on.
 set -euo pipefail
 
 packages=(
@@ -17,9 +19,14 @@ packages=(
   python3-lz4 python3-zstandard python3-flatbuffers
   # benchmarks/plot_methods.py: method_benchmark's PSNR-against-time plots.
   python3-matplotlib
+  # The Python module (python/) and its pytest suite.
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-dev)
+fi
+if [ "${1:-}" = "--train" ]; then
+  packages+=(python3-torch python3-onnx python3-opencv python3-numpy opencv-doc python3-skimage)
 fi
 
 missing=()

@@ -201,6 +201,11 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("fused objective: " + error);
   if (!objective.IsValid(&error)) throw InvalidArgumentError("objective: " + error);
+  if (objective.prior_weight > 0.0) {
+    throw InvalidArgumentError(
+        "fused objective: the quadratic prior (plug & play) is built only by the Ceres problem "
+        "(ceres_lm)");
+  }
   if (!objective.event_model.IsValid(&error)) {
     throw InvalidArgumentError(error + " (derive alpha with EstimateEventModel first)");
   }

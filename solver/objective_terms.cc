@@ -22,6 +22,16 @@ ObjectiveTerms::ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objec
       family_weight(objective.spatial_tv_weight) * per_pixel / num_latent;
   weights_[static_cast<int>(TermFamily::kTemporalTv)] =
       num_latent > 1 ? family_weight(objective.temporal_tv_weight) * per_pixel : 0.0;
+  weights_[static_cast<int>(TermFamily::kPrior)] =
+      family_weight(objective.prior_weight) * per_pixel / num_latent;
+  if (has(TermFamily::kPrior)) {
+    const Video* target = objective.prior_target.get();
+    if (target == nullptr || target->num_frames() != num_latent || target->height() != height_ ||
+        target->width() != width_) {
+      throw InvalidArgumentError(
+          "objective terms: the prior's target video does not match the scene's latent size");
+    }
+  }
 
   const int64_t active = mask.num_active();
   if (has(TermFamily::kFrame)) {
@@ -42,6 +52,9 @@ ObjectiveTerms::ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objec
   }
   if (has(TermFamily::kTemporalTv)) {
     counts_[static_cast<int>(TermFamily::kTemporalTv)] = (num_latent - 1) * active;
+  }
+  if (has(TermFamily::kPrior)) {
+    counts_[static_cast<int>(TermFamily::kPrior)] = static_cast<int64_t>(num_latent) * active;
   }
 }
 

@@ -6,6 +6,7 @@
 //        + λ_e  / (hw)   · Σ_k Σ_p ρ(event term k at p)             (Eqs. 1–2)
 //        + λ_xy / (hw·N) · Σ_t Σ_p ρ(spatial TV term at (t, p))     (Eq. 4)
 //        + λ_t  / (hw)   · Σ_t Σ_p ρ(H_{t+1}(p) − H_t(p))           (Eq. 5)
+//        + ρ_T  / (hw·N) · Σ_t Σ_p ½ (H_t(p) − T_t(p))²            (prior, plug & play)
 //
 // Rules:
 // * A family with weight 0 has no terms; the temporal family has none with one latent frame.
@@ -13,6 +14,9 @@
 // * A spatial TV term exists when any pixel it touches is active; it belongs to its top-left
 //   pixel. Anisotropic TV is two terms per pixel, (p, right) and (p, below); the paper and
 //   isotropic forms one three-point term (p, right, below).
+// * The prior is the one quadratic family: ADMM's coupling term ρ/2‖H − T‖² towards a target
+//   video T (plug & play, paper §3.4), over the active voxels. Only the Ceres problem builds
+//   it; the fused objective rejects it.
 // * Every family is normalised by the image size h·w, so that the weights do not depend on the
 //   resolution; spatial TV also by the N latent frames (a mean over frames: summed, smoothing a
 //   run of m frames would save m times the TV while paying for only two temporal transitions, so
@@ -30,8 +34,8 @@
 namespace evfs {
 
 /// The residual families of the objective.
-enum class TermFamily { kFrame, kEvent, kSpatialTv, kTemporalTv };
-constexpr int kNumTermFamilies = 4;
+enum class TermFamily { kFrame, kEvent, kSpatialTv, kTemporalTv, kPrior };
+constexpr int kNumTermFamilies = 5;
 
 /// The spatial TV terms a pixel owns (as their top-left pixel).
 struct SpatialTvTermsAt {
@@ -45,7 +49,8 @@ struct SpatialTvTermsAt {
 /// terms over voxels (one per latent frame or step, before any merging of quiet steps).
 class ObjectiveTerms {
  public:
-  /// `mask` must match the scene's size and outlive this object.
+  /// `mask` must match the scene's size and outlive this object. Throws InvalidArgumentError
+  /// when the objective has a prior whose target is not of the scene's latent size.
   ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objective, const ActivityMask& mask);
 
   /// Whether the family has terms: weight > 0 (and, for temporal TV, more than one latent frame).

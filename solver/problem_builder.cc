@@ -11,6 +11,7 @@
 #include "cost_functions/difference_residual.h"
 #include "cost_functions/event_residual.h"
 #include "cost_functions/frame_residual.h"
+#include "cost_functions/prior_residual.h"
 #include "cost_functions/spatial_tv_residual.h"
 #include "cost_functions/weighted_l1_loss.h"
 #include "solver/objective_terms.h"
@@ -76,6 +77,7 @@ ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) 
   event_residuals += part.event_residuals;
   spatial_tv_residuals += part.spatial_tv_residuals;
   temporal_tv_residuals += part.temporal_tv_residuals;
+  prior_residuals += part.prior_residuals;
   distinct_cost_functions += part.distinct_cost_functions;
   active_pixels += part.active_pixels;
   skipped_pixels += part.skipped_pixels;
@@ -304,6 +306,27 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
         problem.AddResidualBlock(difference, loss, layout.value(s, latent),
                                  layout.value(s + 1, latent));
         ++statistics.temporal_tv_residuals;
+      });
+    }
+  }
+  if (terms.has(TermFamily::kPrior)) {
+    // One squared residual per unknown, towards the mean of its voxels' targets: its cost
+    // differs from the sum over the voxels by a constant (cost_functions/prior_residual.h).
+    // Targets are continuous, so each residual has its own cost function.
+    const double weight = terms.weight(TermFamily::kPrior);
+    const Video& target = *objective.prior_target;
+    for (const int64_t p : pixels) {
+      if (!mask.active(p)) continue;
+      for_each_segment(p, [&](int64_t s) {
+        const LatentLayout::Segment& segment = layout.segment(s);
+        if (segment.constant) return;
+        double sum = 0.0;
+        for (int t = segment.first; t <= segment.last; ++t) sum += target.frame_data(t)[p];
+        const int length = segment.length();
+        built->cost_functions_.emplace_back(PriorResidual::Create(sum / length, weight * length));
+        problem.AddResidualBlock(built->cost_functions_.back().get(), nullptr,
+                                 layout.value(s, latent));
+        ++statistics.prior_residuals;
       });
     }
   }

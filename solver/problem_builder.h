@@ -25,13 +25,15 @@ struct ProblemStatistics {
   int64_t event_residuals = 0;
   int64_t spatial_tv_residuals = 0;
   int64_t temporal_tv_residuals = 0;
+  int64_t prior_residuals = 0;  // the quadratic prior (plug & play), one per unknown
   int64_t distinct_cost_functions = 0;
   int64_t active_pixels = 0;   // pixels whose time series is solved for
   int64_t skipped_pixels = 0;  // pixels left at their initial value (ActivityMask)
   int64_t parts = 1;           // independent problems (ActivityMask::IndependentParts)
 
   int64_t residual_blocks() const {
-    return frame_residuals + event_residuals + spatial_tv_residuals + temporal_tv_residuals;
+    return frame_residuals + event_residuals + spatial_tv_residuals + temporal_tv_residuals +
+           prior_residuals;
   }
   /// Sums the counts of another part of the same scene.
   ProblemStatistics& operator+=(const ProblemStatistics& part);

@@ -5,10 +5,12 @@
 
 #include <ceres/ceres.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/enum_names.h"
+#include "core/video.h"
 #include "cost_functions/spatial_tv_residual.h"
 #include "scene/event_model.h"
 #include "scene/event_model_estimation.h"
@@ -43,6 +45,12 @@ struct ObjectiveOptions {
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
+  /// ρ: weight of a quadratic prior ρ/2 · mean over the solved voxels of (H_t(p) − T_t(p))²
+  /// that pulls the latent video towards `prior_target` (plug & play's ADMM coupling term,
+  /// paper §3.4 and Table 4); 0: no prior. Only the Ceres problem builds it.
+  double prior_weight = 0.0;
+  /// T: the prior's target, a video of the scene's latent size (needed when prior_weight > 0).
+  std::shared_ptr<const Video> prior_target;
 
   bool IsValid(std::string* error) const;
 

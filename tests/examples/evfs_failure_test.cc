@@ -188,8 +188,8 @@ bool IsProgressLine(const std::string& line) {
   const std::string head = body.substr(0, comma);
   const size_t iteration = head.find(", iteration ");
   const std::string stage = head.substr(0, iteration);
-  const std::vector<std::string> stages = {"read",  "bin",  "build", "build and solve",
-                                           "solve", "write"};
+  const std::vector<std::string> stages = {"read",  "bin",     "build", "build and solve",
+                                           "solve", "denoise", "write"};
   if (std::find(stages.begin(), stages.end(), stage) == stages.end()) return false;
   if (iteration == std::string::npos) return true;
   const std::string rest = head.substr(iteration + std::string(", iteration ").size());

@@ -475,38 +475,83 @@ TEST(Aedat4RealSampleTest, OpensThroughDataSourceAndIsNotEvfsOwn) {
   EXPECT_FALSE(IsAedat4WrittenByEvfs(path));
 }
 
-// Every shared data folder with events, through `evfs convert` to AEDAT 4: the frames exactly
-// (pixels, times, exposures, images.txt paths), the events to the microsecond.
+// `copy` holds the recording `original` as an AEDAT 4 file can: the frames exactly (pixels,
+// times, exposures, images.txt paths), the events to the microsecond.
+void ExpectSameToTheMicrosecond(const DataSource& original, const DataSource& copy,
+                                const std::string& name) {
+  EXPECT_EQ(copy.width(), original.width()) << name;
+  EXPECT_EQ(copy.height(), original.height()) << name;
+  EXPECT_EQ(copy.frames(), original.frames()) << name;
+  for (int i = 0; i < static_cast<int>(original.frames().size()); ++i) {
+    EXPECT_TRUE((copy.ReadImage(i) == original.ReadImage(i)).all()) << name << " frame " << i;
+  }
+  const EventStream expected = original.ReadAllEvents();
+  const EventStream read = copy.ReadAllEvents();
+  ASSERT_EQ(read.size(), expected.size()) << name;
+  size_t mismatches = 0;
+  for (size_t i = 0; i < read.size(); ++i) {
+    // The nearest microsecond, halves up (WriteAedat4); shared times are >= 0.
+    const int64_t t_us = (expected.t_ns(i) + kNsPerUs / 2) / kNsPerUs;
+    mismatches += read.t_ns(i) != t_us * kNsPerUs || read.x(i) != expected.x(i) ||
+                  read.y(i) != expected.y(i) || read.polarity(i) != expected.polarity(i);
+  }
+  EXPECT_EQ(mismatches, 0u) << name;
+}
+
+// The shared folders that are recordings (events.txt beside the frames).
+std::vector<std::filesystem::path> SharedRecordingFolders(const std::string& data_dir) {
+  std::vector<std::filesystem::path> folders;
+  for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
+    if (std::filesystem::is_regular_file(entry.path() / "events.txt")) {
+      folders.push_back(entry.path());
+    }
+  }
+  std::sort(folders.begin(), folders.end());
+  return folders;
+}
+
+// Every shared data folder with events, through `evfs convert` to AEDAT 4.
 TEST(Aedat4RealSampleTest, SharedFoldersConvertLosslesslyToTheMicrosecond) {
   EVFS_REQUIRE_SHARED_DATA(data_dir);
   const std::string scratch = ScratchDir("aedat4_shared_folders");
-  int converted = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
-    if (!std::filesystem::is_regular_file(entry.path() / "events.txt")) continue;
-    const std::string name = entry.path().filename().string();
+  const std::vector<std::filesystem::path> folders = SharedRecordingFolders(data_dir);
+  EXPECT_FALSE(folders.empty());
+  for (const std::filesystem::path& folder : folders) {
+    const std::string name = folder.filename().string();
     const std::string path = scratch + "/" + name + ".aedat4";
-    ConvertRecording(entry.path().string(), path);
-    const auto original = DataSource::Open(entry.path().string());
-    const auto converted_source = DataSource::Open(path);
-    EXPECT_EQ(converted_source->frames(), original->frames()) << name;
-    for (int i = 0; i < static_cast<int>(original->frames().size()); ++i) {
-      EXPECT_TRUE((converted_source->ReadImage(i) == original->ReadImage(i)).all())
-          << name << " frame " << i;
-    }
-    const EventStream expected = original->ReadAllEvents();
-    const EventStream read = converted_source->ReadAllEvents();
-    ASSERT_EQ(read.size(), expected.size()) << name;
-    size_t mismatches = 0;
-    for (size_t i = 0; i < read.size(); ++i) {
-      // The nearest microsecond, halves up (WriteAedat4); shared times are >= 0.
-      const int64_t t_us = (expected.t_ns(i) + kNsPerUs / 2) / kNsPerUs;
-      mismatches += read.t_ns(i) != t_us * kNsPerUs || read.x(i) != expected.x(i) ||
-                    read.y(i) != expected.y(i) || read.polarity(i) != expected.polarity(i);
-    }
-    EXPECT_EQ(mismatches, 0u) << name;
-    ++converted;
+    ConvertRecording(folder.string(), path);
+    ExpectSameToTheMicrosecond(*DataSource::Open(folder.string()), *DataSource::Open(path), name);
   }
-  EXPECT_GT(converted, 0);
+}
+
+// The acceptance test of issue 19: every shared data folder with events, text → AEDAT 4 → text
+// through ConvertRecording (the code of `evfs convert`), is the same recording to the
+// microsecond, AEDAT 4's resolution, with its frames exact. The folders holding frames only are
+// not recordings: convert refuses them (one line, naming `evfs simulate`).
+TEST(Aedat4RealSampleTest, SharedFoldersRoundTripTextToAedat4ToText) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  const std::string scratch = ScratchDir("aedat4_shared_round_trip");
+  int round_trips = 0, frames_only = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
+    const std::filesystem::path folder = entry.path();
+    const std::string name = folder.filename().string();
+    if (!std::filesystem::is_regular_file(folder / "images.txt")) continue;  // not a text folder
+    const std::string aedat4 = scratch + "/" + name + ".aedat4";
+    if (!std::filesystem::exists(folder / "events.txt")) {
+      EXPECT_THROW(ConvertRecording(folder.string(), aedat4), InputError) << name;
+      ++frames_only;
+      continue;
+    }
+    const std::string back = scratch + "/" + name;
+    ConvertRecording(folder.string(), aedat4);
+    ConvertRecording(aedat4, back);
+    ExpectSameToTheMicrosecond(*DataSource::Open(folder.string()), *DataSource::Open(back), name);
+    ++round_trips;
+  }
+  std::printf("round trips: %d folders with events; %d folders of frames only refused\n",
+              round_trips, frames_only);
+  EXPECT_EQ(round_trips, static_cast<int>(SharedRecordingFolders(data_dir).size()));
+  EXPECT_GT(round_trips, 0);
 }
 
 // ---------------------------------------------------------------------------------------------

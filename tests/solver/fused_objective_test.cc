@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <string>
 #include <tuple>
@@ -359,6 +360,17 @@ TEST(FusedObjective, RejectsAnUnderivedAlphaAndBadOptions) {
   const FusedObjective fused(scene, objective, mask);
   EXPECT_THROW(fused.Evaluate(Video(kHeight, kWidth + 1, kNumLatent), nullptr),
                InvalidArgumentError);
+}
+
+// The quadratic prior (plug & play) is built only by the Ceres problem.
+TEST(FusedObjective, RejectsThePrior) {
+  const Scene scene = MakeRandomScene(Binning::kCollision, Activity::kAll, 73);
+  const ActivityMask mask(scene.events, -1);
+  ObjectiveOptions objective;
+  objective.event_model.alpha = 3.0;
+  objective.prior_weight = 10.0;
+  objective.prior_target = std::make_shared<const Video>(InitializeLatentVideo(scene));
+  EXPECT_THROW(FusedObjective(scene, objective, mask), InvalidArgumentError);
 }
 
 }  // namespace

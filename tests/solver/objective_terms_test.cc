@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,9 @@ TEST(ObjectiveTerms, CountsTermsOverVoxelsOfActivePixels) {
 TEST(ObjectiveTerms, ZeroWeightFamiliesHaveNoTerms) {
   const Scene scene = MakeScene({{1, 2, 3}});
   const ActivityMask mask(scene.events, /*radius_px=*/-1);
-  for (int family = 0; family < kNumTermFamilies; ++family) {
+  // The ℓ1 families; the prior (kPrior, last) has weight 0 unless a target is given.
+  const int prior = static_cast<int>(TermFamily::kPrior);
+  for (int family = 0; family < prior; ++family) {
     ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
     double* weights[] = {&objective.frame_weight, &objective.event_weight,
                          &objective.spatial_tv_weight, &objective.temporal_tv_weight};
@@ -77,9 +80,10 @@ TEST(ObjectiveTerms, ZeroWeightFamiliesHaveNoTerms) {
     const ObjectiveTerms terms(scene, objective, mask);
     for (int other = 0; other < kNumTermFamilies; ++other) {
       const TermFamily f = static_cast<TermFamily>(other);
-      EXPECT_EQ(terms.has(f), other != family);
-      EXPECT_EQ(terms.weight(f) > 0.0, other != family);
-      EXPECT_EQ(terms.num_terms(f) > 0, other != family);
+      const bool expected = other != family && other != prior;
+      EXPECT_EQ(terms.has(f), expected);
+      EXPECT_EQ(terms.weight(f) > 0.0, expected);
+      EXPECT_EQ(terms.num_terms(f) > 0, expected);
     }
     if (family == static_cast<int>(TermFamily::kSpatialTv)) {
       for (int64_t p = 0; p < kPixels; ++p) {
@@ -152,6 +156,8 @@ TEST(ObjectiveTerms, ProblemBuilderBuildsTheseTerms) {
       options.activity_radius_px = radius;
       options.merge_quiet_steps = false;
       Video latent = InitializeLatentVideo(scene);
+      options.objective.prior_weight = 3.0;
+      options.objective.prior_target = std::make_shared<const Video>(latent);
       const auto built = ProblemBuilder(scene, options).Build(&latent);
       const ProblemStatistics& statistics = built->statistics();
       const ActivityMask mask(scene.events, radius);
@@ -160,6 +166,8 @@ TEST(ObjectiveTerms, ProblemBuilderBuildsTheseTerms) {
       EXPECT_EQ(statistics.event_residuals, terms.num_terms(TermFamily::kEvent));
       EXPECT_EQ(statistics.spatial_tv_residuals, terms.num_terms(TermFamily::kSpatialTv));
       EXPECT_EQ(statistics.temporal_tv_residuals, terms.num_terms(TermFamily::kTemporalTv));
+      EXPECT_EQ(statistics.prior_residuals, terms.num_terms(TermFamily::kPrior));
+      EXPECT_EQ(statistics.prior_residuals, scene.num_latent_frames() * mask.num_active());
     }
   }
 }
@@ -169,6 +177,25 @@ TEST(ObjectiveTerms, RejectsAMaskOfAnotherSize) {
   const ActivityMask mask(EventFrames(kHeight + 1, kWidth), /*radius_px=*/-1);
   EXPECT_THROW(ObjectiveTerms(scene, MakeObjective(SpatialTv::kAnisotropic), mask),
                InvalidArgumentError);
+}
+
+TEST(ObjectiveTerms, PriorIsAMeanOverVoxelsAndNeedsATargetOfTheLatentSize) {
+  const Scene scene = MakeScene({{1, 2, 3}});
+  const ActivityMask mask(scene.events, /*radius_px=*/-1);
+  ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+  objective.prior_weight = 5.0;
+  std::string error;
+  EXPECT_FALSE(objective.IsValid(&error)) << "a prior without a target";
+  objective.prior_target = std::make_shared<const Video>(InitializeLatentVideo(scene));
+  EXPECT_TRUE(objective.IsValid(&error)) << error;
+  const ObjectiveTerms terms(scene, objective, mask);
+  EXPECT_DOUBLE_EQ(terms.weight(TermFamily::kPrior), 5.0 / kPixels / kNumLatent);
+  EXPECT_EQ(terms.num_terms(TermFamily::kPrior), kNumLatent * kPixels);
+
+  Video short_target;
+  short_target.AppendFrame(Image::Constant(kHeight, kWidth, 0.5), 0);
+  objective.prior_target = std::make_shared<const Video>(short_target);
+  EXPECT_THROW(ObjectiveTerms(scene, objective, mask), InvalidArgumentError);
 }
 
 }  // namespace

@@ -1,0 +1,105 @@
+// The residual denoiser (denoiser/) inside evfs' jobs: once after a reconstruction
+// (`evfs reconstruct --denoise=once`) and on an existing reconstruction folder (`evfs denoise`).
+// Which pixels it may change comes from the solve: those the solver solved for (ActivityMask's
+// active pixels); every pixel a solver skipped keeps its value bit for bit.
+#ifndef EVFS_APP_DENOISE_JOB_H_
+#define EVFS_APP_DENOISE_JOB_H_
+
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/method.h"
+#include "app/plug_and_play.h"
+#include "core/enum_names.h"
+#include "core/video.h"
+#include "denoiser/denoiser.h"
+#include "scene/scene.h"
+
+namespace evfs {
+
+enum class DenoiseMode { kNone, kOnce, kPnp };
+
+inline constexpr EnumName<DenoiseMode> kDenoiseModeNames[] = {
+    {DenoiseMode::kNone, "none", "the reconstruction as the solver left it"},
+    {DenoiseMode::kOnce, "once", "the residual denoiser applied once after the solve"},
+    {DenoiseMode::kPnp, "pnp",
+     "plug & play: ADMM between the Ceres problem and the denoiser (ceres_lm only)"},
+};
+
+/// The weights shipped with evfs: models/evfs_denoiser.onnx next to the executable, in its
+/// ../share/evfs/models, or in the source tree evfs was built from. "" when none exists.
+std::string ShippedDenoiserWeights();
+
+/// What `--denoise=auto` does with the shipped weights: the mode that measured best against the
+/// reconstruction alone on the validation cases (BENCHMARKS.md, "Residual denoiser"); none
+/// while no mode gains over DMR on the mean with the weights shipped.
+inline constexpr DenoiseMode kShippedWeightsDenoiseMode = DenoiseMode::kNone;
+
+/// `--denoise=auto`: once when the user names weights (`weights_path` not empty: they asked for
+/// a denoiser), kShippedWeightsDenoiseMode when weights are shipped, else none.
+DenoiseMode AutoDenoiseMode(const std::string& weights_path);
+
+/// How a job denoises. `denoiser.weights_path` "" means the shipped weights.
+struct DenoiseRequest {
+  DenoiseMode mode = DenoiseMode::kNone;
+  DenoiserOptions denoiser;
+  /// Mode pnp: the ADMM iterations and ρ schedule.
+  PlugAndPlayOptions pnp;
+};
+
+/// What denoising did, for summary.json.
+struct DenoiseRecord {
+  DenoiseMode mode = DenoiseMode::kNone;
+  std::string weights_path;
+  std::string weights_sha256;
+  int margin_px = 0;
+  DenoiseStats stats;
+  /// With a truth frame: the score before denoising (the score after is the job's own).
+  bool scored = false;
+  double psnr_before = 0.0, ssim_before = 0.0;
+  /// Mode pnp: the ADMM iterations (stats then sums every application of the denoiser).
+  PlugAndPlayRecord pnp;
+};
+
+/// The denoiser `request` asks for, loaded (null for mode none). Throws InvalidArgumentError
+/// when a mode needs weights and none are given or shipped, InputError for a bad weights file.
+std::unique_ptr<Denoiser> LoadDenoiser(const DenoiseRequest& request);
+
+/// The pixels `method` solved for on `scene`: the active pixels of an iterative method's
+/// ActivityMask (none when the scene needed no solve), every pixel for a classical baseline.
+DenoiseRegion SolvedRegion(const Scene& scene, const MethodOptions& method, bool solved);
+
+/// Applies `denoiser` to `latent` in place at `region`, scoring frame `truth_index` against
+/// `truth` before it does when `truth` is not null.
+DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
+                                 const DenoiseRegion& region, const Image* truth, int truth_index,
+                                 Video* latent);
+
+/// Throws InvalidArgumentError (one line) when `mode` cannot follow `method`: plug & play
+/// needs the Ceres problem (ceres_lm), whose quadratic prior couples it to the denoiser.
+void CheckDenoiseMode(DenoiseMode mode, Method method);
+
+/// Plug & play on `scene` from the Ceres solve `solved` (its MethodResult, method ceres_lm)
+/// at `region`: replaces solved->video by the result and returns the record, scored like
+/// DenoiseLatentVideo's.
+DenoiseRecord PlugAndPlayLatentVideo(const Denoiser& denoiser, const Scene& scene,
+                                     const MethodOptions& method, const PlugAndPlayOptions& pnp,
+                                     const DenoiseRegion& region, const Image* truth,
+                                     int truth_index, MethodResult* solved);
+
+/// summary.json's "denoiser" object.
+nlohmann::ordered_json DenoiseJson(const DenoiseRecord& record);
+
+/// `evfs denoise`: reads a reconstruction folder (frames/NNNNNN.png, timestamps.txt, written by
+/// `evfs reconstruct`), denoises every pixel of every frame (the folder does not say which
+/// pixels were solved) and writes frames/, timestamps.txt and summary.json into `out_folder`
+/// (an OutputTarget's staging folder). Throws InputError for a folder that is not a
+/// reconstruction.
+DenoiseRecord DenoiseReconstructionFolder(const std::string& in_folder, const Denoiser& denoiser,
+                                          const std::string& out_folder);
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_DENOISE_JOB_H_

@@ -1,0 +1,134 @@
+#include "app/evfs_help.h"
+
+#include "core/version.h"
+
+namespace evfs {
+namespace {
+
+ProgramHelp MakeEvfsHelp() {
+  ProgramHelp help;
+  help.program = "evfs";
+  help.summary = "event-driven video frame synthesis.";
+  help.version = kVersion;
+  help.flags_file = "evfs_main.cc";
+  help.commands = {
+      {"info", "--data=DIR [--first=I --last=J]",
+       "Describe a recording: size, events, frames and exposures; with --first, the window "
+       "between two frames and the binning a reconstruction would get."},
+      {"reconstruct",
+       "--data=DIR --mode=interpolate|predict|deblur --first=I [--last=J] [--truth=K] --out=OUT "
+       "[--fps=N] [method, binning, model and solver flags]",
+       "Synthesise the latent frames between frames I and J from the frames and the events "
+       "(paper §3), into OUT with their timestamps and a summary."},
+      {"video",
+       "--data=DIR --out=OUT [--fps=N] [--first=I --last=J] [--jobs=N] [--resume] [--preview] "
+       "[method, binning, model and solver flags]",
+       "Reconstruct a whole recording, window by window and in parallel, into one video at a "
+       "uniform rate: OUT/frames, timestamps.txt, summary.json and video.mp4."},
+      {"denoise", "--in=RECONSTRUCTION_DIR --out=DIR [--denoiser=FILE.onnx]",
+       "Apply the residual denoiser (paper §3.4) to every frame of an earlier reconstruction."},
+      {"simulate", "--frames=DIR --out=DIR [--threshold_pos=0.2 --threshold_neg=0.2 --seed=42]",
+       "Simulate the events of a sequence of frames, written as a data folder."},
+      {"convert", "--data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR",
+       "Convert a recording between a data folder, HDF5 and AEDAT 4."},
+      {"demo", "--out=DIR",
+       "Run a synthetic scene through the whole pipeline and score every mode against its "
+       "ground truth."},
+  };
+  help.notes =
+      "DIR is a folder in the Event Camera Dataset layout (events.txt 't x y p', images.txt\n"
+      "'t path', images/, optional exposures.txt 'path t_start t_end'), an .h5 file or an\n"
+      ".aedat4 recording (iniVation DV: events and frames).\n"
+      "I, J, K are 0-based lines of images.txt. Example:\n"
+      "  evfs reconstruct --data=../shared/data/slider_depth_70_71 --mode=predict --first=0 "
+      "--last=1 \\\n      --truth=1 --out=out/slider\n";
+  help.groups = {"data",   "output",   "method",    "binning", "model",
+                 "solver", "denoiser", "simulator", "progress"};
+  help.flags = {
+      // Which data and which frames.
+      {"data", "data", "info reconstruct convert video"},
+      {"frames", "data", "simulate"},
+      {"mode", "data", "reconstruct"},
+      {"first", "data", "info reconstruct video"},
+      {"last", "data", "info reconstruct video"},
+      {"truth", "data", "reconstruct"},
+      {"exposure_s", "data", "reconstruct video"},
+      // What is written.
+      {"out", "output", "reconstruct denoise simulate convert demo video"},
+      {"overwrite", "output", "reconstruct denoise simulate convert demo video"},
+      {"fps", "output", "reconstruct video"},
+      // The method and its own settings.
+      {"solver", "method", "reconstruct video"},
+      {"init", "method", "reconstruct video"},
+      {"checkpoints", "method", "reconstruct"},
+      {"adam_iterations", "method", "reconstruct video"},
+      {"adam_learning_rate", "method", "reconstruct video"},
+      {"contrast_threshold", "method", "reconstruct video"},
+      {"blur_sigma_px", "method", "reconstruct video"},
+      {"cf_cutoff_rad_per_s", "method", "reconstruct video"},
+      // Events into event frames (info shows the binning a reconstruction would get).
+      {"binning", "binning", "info reconstruct video"},
+      {"max_latent_frames", "binning", "info reconstruct video"},
+      {"max_latent_voxels", "binning", "info reconstruct video"},
+      {"hot_pixel_factor", "binning", "info reconstruct video"},
+      {"stacked_frames", "binning", "info reconstruct video"},
+      // The objective and the unknowns.
+      {"frame_weight", "model", "reconstruct video"},
+      {"event_weight", "model", "reconstruct video"},
+      {"spatial_tv_weight", "model", "reconstruct video"},
+      {"temporal_tv_weight", "model", "reconstruct video"},
+      {"alpha", "model", "reconstruct video"},
+      {"event_model", "model", "reconstruct video"},
+      {"log_offset", "model", "reconstruct video"},
+      {"spatial_tv", "model", "reconstruct video"},
+      {"smoothing_scale", "model", "reconstruct video"},
+      {"smoothing_continuation", "model", "reconstruct video"},
+      {"bounds", "model", "reconstruct video"},
+      {"activity_radius_px", "model", "reconstruct video"},
+      {"merge_quiet_steps", "model", "reconstruct video"},
+      {"split_independent_parts", "model", "reconstruct video"},
+      // Ceres.
+      {"linear_solver", "solver", "reconstruct video"},
+      {"preconditioner", "solver", "reconstruct video"},
+      {"eta", "solver", "reconstruct video"},
+      {"max_iterations", "solver", "reconstruct video"},
+      {"max_linear_iterations", "solver", "reconstruct video"},
+      {"max_time_s", "solver", "reconstruct video"},
+      {"bounds_line_search_iterations", "solver", "reconstruct video"},
+      {"function_tolerance", "solver", "reconstruct video"},
+      {"threads", "solver", "reconstruct video"},
+      // The residual denoiser.
+      {"in", "denoiser", "denoise"},
+      {"denoise", "denoiser", "reconstruct video"},
+      {"denoiser", "denoiser", "reconstruct denoise video"},
+      // evfs video's own.
+      {"jobs", "solver", "video"},
+      {"resume", "output", "video"},
+      {"preview", "output", "video"},
+      {"predict_tail", "data", "video"},
+      {"predict_max_s", "data", "video"},
+      {"min_blur_exposure_s", "data", "video"},
+      {"frame_step", "data", "video"},
+      {"skip_bad_frames", "data", "video"},
+      // The event simulator.
+      {"threshold_pos", "simulator", "simulate"},
+      {"threshold_neg", "simulator", "simulate"},
+      {"threshold_sigma", "simulator", "simulate"},
+      {"refractory_s", "simulator", "simulate"},
+      {"noise_rate_hz", "simulator", "simulate"},
+      {"seed", "simulator", "simulate"},
+      // What a running command prints.
+      {"progress", "progress", "reconstruct"},
+      {"progress_interval_s", "progress", "*"},
+  };
+  return help;
+}
+
+}  // namespace
+
+const ProgramHelp& EvfsHelp() {
+  static const ProgramHelp* const help = new ProgramHelp(MakeEvfsHelp());
+  return *help;
+}
+
+}  // namespace evfs

@@ -1,0 +1,640 @@
+#include "app/video_job.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "app/video_writer.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/option_checker.h"
+#include "core/parallel.h"
+#include "core/time.h"
+#include "io/data_source.h"
+#include "io/image_io.h"
+#include "scene/scene.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
+
+// The marker of a work folder: its first line, then the run's settings.
+constexpr char kWorkMarkerFile[] = ".evfs-video-work";
+constexpr char kWorkMarkerTitle[] = "evfs video work folder";
+// Most output frames a video may have (a runaway --fps would fill the disk).
+constexpr int64_t kMaxOutputFrames = 10000000;
+// A time beyond any recording's last event, with room to add to it.
+constexpr int64_t kFarFutureNs = std::numeric_limits<int64_t>::max() / 4;
+
+// JSON has no inf or nan: they become null.
+Json Number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
+
+std::string FrameName(int64_t n) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06lld", static_cast<long long>(n));
+  return name;
+}
+
+// Writes `text` to `path` under a temporary name, then renames it: the file appears whole.
+void WriteFileAtomically(const fs::path& path, const std::string& text) {
+  const fs::path temporary = path.string() + ".tmp";
+  std::ofstream file(temporary);
+  file << text;
+  file.close();
+  std::error_code error;
+  if (!file || (fs::rename(temporary, path, error), error)) {
+    throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "cannot write it");
+  }
+}
+
+std::string ReadWholeFile(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+bool IsOwnWorkFolder(const fs::path& folder) {
+  std::error_code error;
+  if (fs::is_symlink(folder, error) || !fs::is_directory(folder, error)) return false;
+  const fs::path marker = folder / kWorkMarkerFile;
+  if (fs::is_symlink(marker, error) || !fs::is_regular_file(marker, error)) return false;
+  std::ifstream file(marker);
+  std::string title;
+  std::getline(file, title);
+  return title == kWorkMarkerTitle;
+}
+
+// Makes the work folder ready and returns the records of the windows it already holds (only
+// with `resume`, and only when the settings match).
+std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string& fingerprint,
+                                      bool resume) {
+  std::error_code error;
+  const bool exists = fs::exists(fs::symlink_status(folder, error));
+  if (exists && !IsOwnWorkFolder(folder)) {
+    throw InvalidArgumentError(folder.string() +
+                               " exists and is not an evfs video work folder: evfs keeps "
+                               "unfinished windows there; move it away");
+  }
+  const std::string marker_text = std::string(kWorkMarkerTitle) + "\n" + fingerprint;
+  std::map<int, Json> done;
+  if (exists && resume) {
+    if (ReadWholeFile(folder / kWorkMarkerFile) != marker_text) {
+      throw InvalidArgumentError(
+          "--resume: the interrupted run in " + folder.string() +
+          " had other settings or data; run again without --resume to start over");
+    }
+    for (const auto& entry : fs::directory_iterator(folder / "windows", error)) {
+      if (entry.path().extension() != ".json") continue;
+      try {
+        Json record = Json::parse(ReadWholeFile(entry.path()));
+        done[record.at("index").get<int>()] = std::move(record);
+      } catch (const std::exception&) {
+        // An unreadable record is a window to solve again.
+      }
+    }
+    return done;
+  }
+  error.clear();
+  if (exists) fs::remove_all(folder, error);
+  if (error || !fs::create_directory(folder, error) || error ||
+      !fs::create_directory(folder / "frames", error) ||
+      !fs::create_directory(folder / "windows", error)) {
+    throw InputError(InputError::Kind::kUnwritable, folder.string(), 0,
+                     "cannot create the work folder: " + error.message());
+  }
+  WriteFileAtomically(folder / kWorkMarkerFile, marker_text);
+  return done;
+}
+
+// What a window depends on, for the fingerprint of a run.
+std::string PlanText(const std::vector<VideoWindow>& windows, const OutputClock& clock) {
+  std::ostringstream text;
+  for (const VideoWindow& window : windows) {
+    int64_t begin = 0, end = 0;
+    clock.FramesOf(window, &begin, &end);
+    text << window.index << ' ' << NameOf(kVideoWindowKindNames, window.kind);
+    for (const VideoWindowFrame& frame : window.frames) {
+      text << ' ' << frame.index << (frame.blurred ? "b" : "s");
+    }
+    text << ' ' << window.begin_ns << ' ' << window.end_ns << ' ' << begin << ' ' << end << '\n';
+  }
+  return text.str();
+}
+
+// Serialises reads of the recording (DataSource is not thread-safe) and names bad frames.
+class SharedSource {
+ public:
+  explicit SharedSource(const std::string& path) : source_(DataSource::Open(path)) {}
+
+  const DataSource& unlocked() const { return *source_; }
+
+  Image ReadImage(int index) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    try {
+      return source_->ReadImage(index);
+    } catch (const InputError& error) {
+      throw InputError(error.kind(), error.file(), error.line(),
+                       std::string("frame ") + std::to_string(index) + ": " + error.what() +
+                           " (--skip_bad_frames goes on across it)");
+    }
+  }
+  EventStream ReadEvents(int64_t begin_ns, int64_t end_ns) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return source_->ReadEvents(begin_ns, end_ns);
+  }
+
+ private:
+  std::unique_ptr<DataSource> source_;
+  mutable std::mutex mutex_;
+};
+
+struct WindowContext {
+  const VideoRequest* request = nullptr;
+  const SharedSource* source = nullptr;
+  const OutputClock* clock = nullptr;
+  MethodOptions method;  // with the per-window thread count
+  const Denoiser* denoiser = nullptr;
+  std::mutex* denoiser_mutex = nullptr;
+  fs::path work;
+};
+
+// Solves one window, writes the output frames it owns into the work folder and returns its
+// record (written last).
+Json RunWindow(const VideoWindow& window, const WindowContext& context) {
+  const auto start = Clock::now();
+  const VideoRequest& request = *context.request;
+  std::vector<TimedFrame> frames;
+  for (const VideoWindowFrame& observed : window.frames) {
+    TimedFrame frame;
+    frame.image = context.source->ReadImage(observed.index);
+    frame.exposure_begin_ns = observed.exposure_begin_ns;
+    frame.exposure_end_ns = observed.exposure_end_ns;
+    frame.label = context.source->unlocked().frames()[observed.index].path;
+    frames.push_back(std::move(frame));
+  }
+  const EventStream events = context.source->ReadEvents(window.begin_ns, window.end_ns);
+  const double read_s = SecondsSince(start);
+
+  const auto bin_start = Clock::now();
+  const Scene scene = MakeScene(frames, events, window.begin_ns, window.end_ns, request.binning);
+  const double bin_s = SecondsSince(bin_start);
+  std::string why_not;
+  if (!MethodSupports(context.method.method, scene, &why_not)) {
+    throw InvalidArgumentError(std::string("--solver=") + MethodName(context.method.method) +
+                               " cannot reconstruct window " + std::to_string(window.index) + ": " +
+                               why_not);
+  }
+  MethodResult run = RunMethod(scene, context.method, IterationCallback(), false, nullptr);
+  double denoise_s = 0.0;
+  if (context.denoiser != nullptr) {
+    const auto denoise_start = Clock::now();
+    const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
+    DenoiseLatentVideo(*context.denoiser, request.denoise.mode,
+                       SolvedRegion(scene, context.method, run.solved), nullptr, -1, &run.video);
+    denoise_s = SecondsSince(denoise_start);
+  }
+  // A sharp observed frame is the output at its own time, unchanged.
+  Video& latent = run.video;
+  for (size_t k = 0; k < window.frames.size(); ++k) {
+    if (window.frames[k].blurred) continue;
+    const int at = latent.NearestFrame(window.frames[k].t_ns);
+    if (latent.timestamp_ns(at) == window.frames[k].t_ns) latent.frame(at) = frames[k].image;
+  }
+
+  const auto write_start = Clock::now();
+  int64_t begin = 0, end = 0;
+  context.clock->FramesOf(window, &begin, &end);
+  for (int64_t n = begin; n < end; ++n) {
+    const fs::path final_path = context.work / "frames" / (FrameName(n) + ".png");
+    const fs::path temporary = context.work / "frames" / (FrameName(n) + ".tmp.png");
+    WriteGreyPng16(temporary.string(), latent.InterpolateAt(context.clock->TimeNs(n)));
+    std::error_code error;
+    fs::rename(temporary, final_path, error);
+    if (error) {
+      throw InputError(InputError::Kind::kUnwritable, final_path.string(), 0, error.message());
+    }
+  }
+  const double write_s = SecondsSince(write_start);
+
+  Json record;
+  record["index"] = window.index;
+  record["mode"] = NameOf(kVideoWindowKindNames, window.kind);
+  Json observed = Json::array();
+  for (const VideoWindowFrame& frame : window.frames) {
+    observed.push_back({{"index", frame.index},
+                        {"timestamp_s", NanosecondsToSeconds(frame.t_ns)},
+                        {"blurred", frame.blurred}});
+  }
+  record["frames"] = std::move(observed);
+  record["t_begin_s"] = NanosecondsToSeconds(window.begin_ns);
+  record["t_end_s"] = NanosecondsToSeconds(window.end_ns);
+  record["output_frames"] = {begin, end};
+  record["events"] = scene.num_events;
+  record["hot_pixels"] = scene.hot_pixels.size();
+  record["event_frames"] = scene.events.num_frames();
+  record["latent_frames"] = latent.num_frames();
+  record["solved"] = run.solved;
+  record["message"] = run.message;
+  record["iterations"] = run.iterations;
+  record["initial_cost"] = Number(run.initial_cost);
+  record["final_cost"] = Number(run.final_cost);
+  if (!window.truth_frames.empty()) {
+    const Video blend = InitializeLatentVideo(scene);
+    Json scores = Json::array();
+    for (const int index : window.truth_frames) {
+      const Image truth = context.source->ReadImage(index);
+      const int64_t t_ns = context.source->unlocked().frames()[index].t_ns;
+      const Image estimate = latent.InterpolateAt(t_ns);
+      const Image blended = blend.InterpolateAt(t_ns);
+      scores.push_back({{"index", index},
+                        {"psnr", Number(Psnr(estimate, truth))},
+                        {"ssim", Number(Ssim(estimate, truth))},
+                        {"blend_psnr", Number(Psnr(blended, truth))},
+                        {"blend_ssim", Number(Ssim(blended, truth))}});
+    }
+    record["truth"] = std::move(scores);
+  }
+  record["time_s"] = {{"read", Number(read_s)},
+                      {"bin", Number(bin_s)},
+                      {"build", Number(run.build_time_s)},
+                      {"solve", Number(run.solve_time_s)},
+                      {"denoise", Number(denoise_s)},
+                      {"write", Number(write_s)},
+                      {"total", Number(SecondsSince(start))}};
+  WriteFileAtomically(context.work / "windows" / (FrameName(window.index) + ".json"),
+                      record.dump(2) + "\n");
+  return record;
+}
+
+void LinkFrame(const fs::path& from, const fs::path& to) {
+  std::error_code error;
+  fs::create_hard_link(from, to, error);
+  if (error) {
+    error.clear();
+    fs::copy_file(from, to, error);
+  }
+  if (error) throw InputError(InputError::Kind::kUnwritable, to.string(), 0, error.message());
+}
+
+// preview.mp4: the last observed frame | the reconstruction | the step's events (red: brighter,
+// blue: darker, on grey).
+void WritePreview(const std::vector<VideoWindow>& windows, const SharedSource& source,
+                  const OutputClock& clock, double fps, const fs::path& work,
+                  const fs::path& path) {
+  const int width = source.unlocked().width(), height = source.unlocked().height();
+  Mp4Writer writer(path.string(), fps, 3 * width, height);
+  std::vector<unsigned char> pixels(static_cast<size_t>(3) * 3 * width * height);
+  const auto put_grey = [&](int panel, const Image& image) {
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const auto byte =
+            static_cast<unsigned char>(std::lround(std::clamp(image(y, x), 0.0, 1.0) * 255.0));
+        unsigned char* pixel =
+            &pixels[3 * (static_cast<size_t>(y) * 3 * width + panel * width + x)];
+        pixel[0] = pixel[1] = pixel[2] = byte;
+      }
+    }
+  };
+  const int64_t step_ns = SecondsToNanoseconds(1.0 / fps);
+  for (const VideoWindow& window : windows) {
+    int64_t begin = 0, end = 0;
+    clock.FramesOf(window, &begin, &end);
+    if (begin == end) continue;
+    const int64_t events_begin_ns = clock.TimeNs(begin) - step_ns;
+    const EventStream events = source.ReadEvents(events_begin_ns, clock.TimeNs(end - 1) + 1);
+    std::vector<Image> observed;
+    for (const VideoWindowFrame& frame : window.frames)
+      observed.push_back(source.ReadImage(frame.index));
+    size_t next_event = 0;
+    for (int64_t n = begin; n < end; ++n) {
+      const int64_t t_ns = clock.TimeNs(n);
+      const size_t shown = window.frames.size() > 1 && t_ns >= window.frames[1].t_ns ? 1 : 0;
+      put_grey(0, observed[shown]);
+      put_grey(1, ReadGreyImage((work / "frames" / (FrameName(n) + ".png")).string()));
+      for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+          unsigned char* pixel = &pixels[3 * (static_cast<size_t>(y) * 3 * width + 2 * width + x)];
+          pixel[0] = pixel[1] = pixel[2] = 128;
+        }
+      }
+      const int64_t previous_ns = n > 0 ? clock.TimeNs(n - 1) : t_ns - step_ns;
+      while (next_event < events.size() && events.t_ns(next_event) <= t_ns) {
+        if (events.t_ns(next_event) > previous_ns) {
+          unsigned char* pixel =
+              &pixels[3 * (static_cast<size_t>(events.y(next_event)) * 3 * width + 2 * width +
+                           events.x(next_event))];
+          const bool brighter = events.polarity(next_event) > 0;  // BGR order
+          pixel[0] = brighter ? 0 : 255;
+          pixel[1] = 0;
+          pixel[2] = brighter ? 255 : 0;
+        }
+        ++next_event;
+      }
+      writer.WriteBgr(pixels.data());
+    }
+  }
+  writer.Close();
+}
+
+}  // namespace
+
+bool VideoRequest::IsValid(std::string* error) const {
+  OptionChecker check;
+  check.Valid(windows)
+      .Require(std::isfinite(fps) && fps >= 0.0, "--fps", "a number of frames per second >= 0")
+      .InRange("--jobs", jobs, 0, 4096)
+      .InRange("--threads", threads_per_window, 0, 4096)
+      .Valid(method.reconstruction)
+      .Valid(binning);
+  return check.Passed(error);
+}
+
+std::string VideoWorkFolder(const std::string& out_path) {
+  const fs::path out = fs::path(out_path).lexically_normal();
+  const fs::path name = out.has_filename() ? out.filename() : out.parent_path().filename();
+  const fs::path parent = out.has_filename() ? out.parent_path() : out.parent_path().parent_path();
+  return (parent / ("." + name.string() + ".evfs-video-work")).string();
+}
+
+void RemoveVideoWorkFolder(const std::string& out_path) {
+  const fs::path folder = VideoWorkFolder(out_path);
+  std::error_code error;
+  if (IsOwnWorkFolder(folder)) fs::remove_all(folder, error);
+}
+
+std::string VideoProgressLine(const VideoProgress& progress) {
+  constexpr int kBarWidth = 20;
+  const int total = std::max(progress.windows_total, 1);
+  const int filled = kBarWidth * progress.windows_done / total;
+  std::string line = "[" + std::string(filled, '#') + std::string(kBarWidth - filled, '.') + "] ";
+  char text[160];
+  const int solved = progress.windows_done - progress.windows_resumed;
+  const int left = progress.windows_total - progress.windows_done;
+  const double eta_s = solved > 0 ? progress.elapsed_s / solved * left : 0.0;
+  const double events_per_s = progress.elapsed_s > 0.0
+                                  ? static_cast<double>(progress.events_done) / progress.elapsed_s
+                                  : 0.0;
+  std::snprintf(
+      text, sizeof(text), "%d/%d windows, %.1f s, ETA %s, %.1f k events/s", progress.windows_done,
+      progress.windows_total, progress.elapsed_s,
+      solved > 0 ? (std::to_string(static_cast<int>(std::ceil(eta_s))) + " s").c_str() : "?",
+      events_per_s / 1000.0);
+  return line + text;
+}
+
+VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
+                     const std::string& staging) {
+  const auto total_start = Clock::now();
+  std::string error;
+  if (!request.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
+  if (request.denoise.mode == DenoiseMode::kPnp) {
+    throw InvalidArgumentError("evfs video denoises with --denoise=once or none, not pnp");
+  }
+  // Loaded before any input is read: a bad weights file fails in milliseconds.
+  const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request.denoise);
+  const SharedSource source(request.data_path);
+  const DataSource& data = source.unlocked();
+
+  VideoResult result;
+  result.width = data.width();
+  result.height = data.height();
+  VideoWindowOptions window_options = request.windows;
+  if (request.skip_bad_frames) {
+    const int last = window_options.last >= 0
+                         ? std::min<int>(window_options.last, data.frames().size() - 1)
+                         : static_cast<int>(data.frames().size()) - 1;
+    for (int i = std::max(window_options.first, 0); i <= last; ++i) {
+      try {
+        source.ReadImage(i);
+      } catch (const InputError&) {
+        window_options.excluded_frames.push_back(i);
+        result.skipped_frames.push_back(i);
+      }
+    }
+  }
+  // The prediction tail ends at the last event: planned first against a far end, then once
+  // more against the last event actually found there.
+  std::vector<VideoWindow> windows =
+      PlanVideoWindows(data.frames(), data.has_events(), kFarFutureNs, window_options);
+  if (data.has_events() && windows.back().kind == VideoWindowKind::kPredict) {
+    const VideoWindow& tail = windows.back();
+    int64_t last_event_ns = 0;
+    if (tail.end_ns >= kFarFutureNs) {
+      last_event_ns = data.Summarize().t_last_ns;
+    } else {
+      const EventStream events = source.ReadEvents(tail.frames[0].t_ns, tail.end_ns);
+      // No event after the last frame: a time before it, so that no tail is planned.
+      last_event_ns = events.empty() ? tail.frames[0].t_ns - 1 : events.last_t_ns();
+    }
+    windows = PlanVideoWindows(data.frames(), true, last_event_ns, window_options);
+  }
+  result.windows = static_cast<int>(windows.size());
+
+  double fps = request.fps;
+  if (fps == 0.0) {
+    // The observed frames' mean rate over the video, times the upsampling.
+    const double span_s =
+        NanosecondsToSeconds(windows.back().output_end_ns - windows.front().output_begin_ns);
+    const double observed_rate = windows.size() / std::max(span_s, 1e-9);
+    fps = std::round(kDefaultUpsampling * observed_rate);
+    fps = std::max(fps, 1.0);
+  }
+  result.fps = fps;
+  const OutputClock clock(windows.front().output_begin_ns, fps);
+  int64_t ignored = 0;
+  clock.FramesOf(windows.back(), &ignored, &result.output_frames);
+  if (result.output_frames > kMaxOutputFrames) {
+    throw InvalidArgumentError("--fps=" + std::to_string(fps) + " would make " +
+                               std::to_string(result.output_frames) + " frames, more than " +
+                               std::to_string(kMaxOutputFrames));
+  }
+
+  // The run's fingerprint: what must not change for --resume to reuse windows.
+  std::ostringstream fingerprint;
+  fingerprint << "data " << fs::absolute(request.data_path).lexically_normal().string() << "\n"
+              << "fps " << fps << "\n"
+              << "settings " << request.settings << "\n"
+              << PlanText(windows, clock);
+  const fs::path work = VideoWorkFolder(out_path);
+  std::map<int, Json> records = PrepareWorkFolder(work, fingerprint.str(), request.resume);
+  // The work folder outlives a signal (that is what --resume is for), not an error: a run that
+  // failed leaves nothing behind.
+  struct RemoveOnError {
+    fs::path folder;
+    bool armed = true;
+    ~RemoveOnError() {
+      std::error_code ignored;
+      if (armed) fs::remove_all(folder, ignored);
+    }
+  } remove_on_error{work};
+  std::fprintf(stderr, "DEBUG records %zu\n", records.size());
+  for (auto it = records.begin(); it != records.end();) {
+    // A recorded window is reused only when every frame it wrote is still there.
+    bool complete = it->first >= 0 && it->first < result.windows;
+    if (complete) {
+      int64_t begin = 0, end = 0;
+      clock.FramesOf(windows[it->first], &begin, &end);
+      for (int64_t n = begin; n < end && complete; ++n) {
+        complete = fs::is_regular_file(work / "frames" / (FrameName(n) + ".png"));
+      }
+    }
+    it = complete ? std::next(it) : records.erase(it);
+  }
+  result.windows_resumed = static_cast<int>(records.size());
+  std::vector<int> pending;
+  for (const VideoWindow& window : windows) {
+    if (records.count(window.index) == 0) pending.push_back(window.index);
+  }
+
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  result.jobs = request.jobs > 0 ? request.jobs : cores;
+  result.threads_per_window = request.threads_per_window > 0 ? request.threads_per_window
+                                                             : std::max(1, cores / result.jobs);
+  WindowContext context;
+  context.request = &request;
+  context.source = &source;
+  context.clock = &clock;
+  context.method = request.method;
+  context.method.reconstruction.solver.num_threads = result.threads_per_window;
+  context.method.adam.num_threads = result.threads_per_window;
+  context.method.lbfgs.num_threads = result.threads_per_window;
+  context.denoiser = denoiser.get();
+  std::mutex denoiser_mutex, progress_mutex;
+  context.denoiser_mutex = &denoiser_mutex;
+  context.work = work;
+
+  VideoProgress progress;
+  progress.windows_total = result.windows;
+  progress.windows_done = progress.windows_resumed = result.windows_resumed;
+  std::atomic<bool> failed(false);
+  const auto solve_start = Clock::now();
+  ParallelForEach(static_cast<int>(pending.size()), result.jobs, [&](int k) {
+    if (failed) return;  // an earlier window failed: the run ends with its error
+    try {
+      Json record = RunWindow(windows[pending[k]], context);
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      progress.events_done += record["events"].get<int64_t>();
+      ++progress.windows_done;
+      progress.elapsed_s = SecondsSince(solve_start);
+      records[pending[k]] = std::move(record);
+      if (request.progress) request.progress(progress);
+    } catch (...) {
+      failed = true;
+      throw;
+    }
+  });
+  result.solve_wall_s = SecondsSince(solve_start);
+  const int solved = static_cast<int>(pending.size());
+  result.windows_per_s = result.solve_wall_s > 0.0 ? solved / result.solve_wall_s : 0.0;
+  result.events_per_s =
+      result.solve_wall_s > 0.0 ? progress.events_done / result.solve_wall_s : 0.0;
+
+  // Assembly, in the OutputTarget's staging folder.
+  const fs::path out = staging;
+  fs::create_directories(out / "frames");
+  std::vector<int64_t> times;
+  for (int64_t n = 0; n < result.output_frames; ++n) {
+    LinkFrame(work / "frames" / (FrameName(n) + ".png"), out / "frames" / (FrameName(n) + ".png"));
+    times.push_back(clock.TimeNs(n));
+  }
+  WriteTimestampsTxt((out / "timestamps.txt").string(), times);
+  {
+    Mp4Writer video((out / "video.mp4").string(), fps, result.width, result.height);
+    for (int64_t n = 0; n < result.output_frames; ++n) {
+      video.WriteGrey(ReadGreyImage((work / "frames" / (FrameName(n) + ".png")).string()));
+    }
+    video.Close();
+    result.codec = video.codec();
+  }
+  if (request.preview) WritePreview(windows, source, clock, fps, work, out / "preview.mp4");
+
+  Json window_records = Json::array();
+  std::vector<double> psnr, ssim, blend_psnr, blend_ssim;
+  for (int i = 0; i < result.windows; ++i) {
+    const Json& record = records.at(i);
+    result.events += record["events"].get<int64_t>();
+    if (record.contains("truth")) {
+      for (const Json& score : record["truth"]) {
+        psnr.push_back(score["psnr"].is_number() ? score["psnr"].get<double>() : 0.0);
+        ssim.push_back(score["ssim"].is_number() ? score["ssim"].get<double>() : 0.0);
+        blend_psnr.push_back(score["blend_psnr"].is_number() ? score["blend_psnr"].get<double>()
+                                                             : 0.0);
+        blend_ssim.push_back(score["blend_ssim"].is_number() ? score["blend_ssim"].get<double>()
+                                                             : 0.0);
+      }
+    }
+    window_records.push_back(record);
+  }
+  const auto mean = [](const std::vector<double>& values) {
+    double sum = 0.0;
+    for (const double value : values) sum += value;
+    return values.empty() ? 0.0 : sum / values.size();
+  };
+  const auto worst = [](const std::vector<double>& values) {
+    return values.empty() ? 0.0 : *std::min_element(values.begin(), values.end());
+  };
+  result.truth_frames = static_cast<int>(psnr.size());
+  result.mean_psnr = mean(psnr);
+  result.worst_psnr = worst(psnr);
+  result.mean_ssim = mean(ssim);
+  result.worst_ssim = worst(ssim);
+  result.mean_blend_psnr = mean(blend_psnr);
+  result.mean_blend_ssim = mean(blend_ssim);
+  result.total_wall_s = SecondsSince(total_start);
+
+  Json summary;
+  summary["command"] = "video";
+  summary["data"] = request.data_label.empty() ? request.data_path : request.data_label;
+  summary["width"] = result.width;
+  summary["height"] = result.height;
+  summary["fps"] = Number(fps);
+  summary["output_frames"] = result.output_frames;
+  summary["t_begin_s"] = NanosecondsToSeconds(clock.TimeNs(0));
+  summary["resampling"] =
+      "linear between the two latent frames around each output time; sharp observed frames "
+      "exact at their own times";
+  summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
+  if (request.preview) summary["preview"] = "preview.mp4";
+  summary["solver"] = MethodName(request.method.method);
+  summary["denoiser"] =
+      denoiser != nullptr ? NameOf(kDenoiseModeNames, request.denoise.mode) : "none";
+  summary["events"] = result.events;
+  summary["skipped_frames"] = result.skipped_frames;
+  if (result.truth_frames > 0) {
+    summary["truth"] = {{"frames", result.truth_frames},
+                        {"mean_psnr", Number(result.mean_psnr)},
+                        {"worst_psnr", Number(result.worst_psnr)},
+                        {"mean_ssim", Number(result.mean_ssim)},
+                        {"worst_ssim", Number(result.worst_ssim)},
+                        {"blend_mean_psnr", Number(result.mean_blend_psnr)},
+                        {"blend_mean_ssim", Number(result.mean_blend_ssim)}};
+  }
+  summary["run"] = {{"jobs", result.jobs},
+                    {"threads_per_window", result.threads_per_window},
+                    {"windows_resumed", result.windows_resumed},
+                    {"solve_wall_s", Number(result.solve_wall_s)},
+                    {"total_wall_s", Number(result.total_wall_s)},
+                    {"windows_per_s", Number(result.windows_per_s)},
+                    {"events_per_s", Number(result.events_per_s)}};
+  summary["windows"] = std::move(window_records);
+  WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  remove_on_error.armed = false;
+  return result;
+}
+
+}  // namespace evfs

@@ -1,0 +1,108 @@
+// `evfs video`: a whole recording to one high-framerate video. The recording is cut into
+// windows (app/video_windows.h) that are reconstructed independently and concurrently, each
+// reading only its own events, and each writing the output frames it owns; the timestamps,
+// summary and MP4 files are assembled at the end.
+//
+// Resampling. The output runs at a uniform rate: frame n at t_first + n / fps. Each output
+// frame is the linear interpolation of the two latent frames of its window around its time
+// (Video::InterpolateAt); a sharp observed frame replaces the latent frame at its own time, so
+// an output time on an observed frame reproduces that frame exactly and windows meet there.
+//
+// Resuming. Windows are written into a work folder beside the output, ".NAME.evfs-video-work"
+// (VideoWorkFolder), marked as evfs's by the file .evfs-video-work, which holds the run's
+// settings. A window's frames are written under temporary names and renamed; its record
+// (windows/WWWWWW.json) is written last, the same way, so a window with a record is complete.
+// Unlike an OutputTarget's staging folder, the work folder survives a signal; `--resume`
+// reuses the recorded windows when the settings match, and solves the others. Once the output
+// is committed (frames hard-linked from the work folder into the OutputTarget's staging folder,
+// so an interrupted assembly loses nothing), RemoveVideoWorkFolder deletes it. Without
+// --resume an earlier work folder of the same output is discarded; a path there that evfs did
+// not mark is never touched.
+#ifndef EVFS_APP_VIDEO_JOB_H_
+#define EVFS_APP_VIDEO_JOB_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "app/denoise_job.h"
+#include "app/method.h"
+#include "app/video_windows.h"
+#include "events/binning.h"
+
+namespace evfs {
+
+/// Output frames per observed frame interval when --fps is 0: the upsampling the method is
+/// for (a DAVIS frame every 20–50 ms becomes a 200–500 fps video).
+inline constexpr double kDefaultUpsampling = 10.0;
+
+/// Where a video job stands, after each window.
+struct VideoProgress {
+  int windows_done = 0;  // including resumed ones
+  int windows_total = 0;
+  int windows_resumed = 0;  // taken from an interrupted run
+  int64_t events_done = 0;  // events of the windows solved in this run
+  double elapsed_s = 0.0;
+};
+
+struct VideoRequest {
+  std::string data_path;   // data folder, HDF5 or AEDAT 4 file
+  std::string data_label;  // how summary.json names the data ("": data_path)
+  VideoWindowOptions windows;
+  double fps = 0.0;              // output rate; 0: kDefaultUpsampling × the observed frame rate
+  int jobs = 0;                  // windows solved at once; 0: every core
+  int threads_per_window = 0;    // each solve's threads; 0: the cores left, cores / jobs (>= 1)
+  bool skip_bad_frames = false;  // leave unreadable frames out instead of failing
+  bool resume = false;           // reuse the windows an interrupted run finished
+  bool preview = false;          // also preview.mp4: observed | reconstruction | events
+  BinningOptions binning;
+  MethodOptions method;  // solver threads are set per window from threads_per_window
+  DenoiseRequest denoise;
+  /// Everything else that decides the output (the command line's settings); --resume reuses
+  /// windows only when it is unchanged.
+  std::string settings;
+  /// Called after each window, from the worker threads, one call at a time; may be empty.
+  std::function<void(const VideoProgress&)> progress;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct VideoResult {
+  int width = 0, height = 0;
+  double fps = 0.0;
+  int windows = 0;
+  int windows_resumed = 0;
+  std::vector<int> skipped_frames;  // left out as unreadable (--skip_bad_frames)
+  int64_t output_frames = 0;
+  int64_t events = 0;  // events of all windows
+  int jobs = 0, threads_per_window = 0;
+  double solve_wall_s = 0.0;  // the windows, wall clock
+  double total_wall_s = 0.0;
+  double windows_per_s = 0.0;  // windows solved in this run / solve_wall_s
+  double events_per_s = 0.0;
+  std::string codec;     // of video.mp4
+  int truth_frames = 0;  // withheld frames scored (frame_step > 1)
+  double mean_psnr = 0.0, worst_psnr = 0.0, mean_blend_psnr = 0.0;
+  double mean_ssim = 0.0, worst_ssim = 0.0, mean_blend_ssim = 0.0;
+};
+
+/// The work folder of the video written to `out_path` (absolute, as OutputTarget::path()).
+std::string VideoWorkFolder(const std::string& out_path);
+
+/// Runs the job: windows into the work folder of `out_path`, then frames/, timestamps.txt,
+/// summary.json, video.mp4 (and preview.mp4) into `staging` (an OutputTarget's staging folder,
+/// for `out_path`). Throws evfs::Error for bad options or input, InvalidArgumentError when the
+/// work folder's path holds something evfs did not mark as its own.
+VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
+                     const std::string& staging);
+
+/// Deletes the work folder of `out_path` (after its output was committed), if evfs marked it.
+void RemoveVideoWorkFolder(const std::string& out_path);
+
+/// One progress line: "[#####.....] 5/10 windows, 12.3 s, ETA 12 s, 41.2 k events/s".
+std::string VideoProgressLine(const VideoProgress& progress);
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_VIDEO_JOB_H_

@@ -1,0 +1,50 @@
+// Encoding frame sequences as MP4 files through OpenCV's VideoWriter (the FFmpeg back end of
+// Debian's OpenCV), for `evfs video`.
+#ifndef EVFS_APP_VIDEO_WRITER_H_
+#define EVFS_APP_VIDEO_WRITER_H_
+
+#include <memory>
+#include <string>
+
+#include "core/video.h"
+
+namespace cv {
+class VideoWriter;
+}
+
+namespace evfs {
+
+/// The codecs tried, best first, as FourCC strings: H.264 ("avc1", which plays in browsers and
+/// every common player), then MPEG-4 Part 2 ("mp4v", which FFmpeg always has).
+extern const char* const kMp4Codecs[2];
+
+/// One MP4 file written frame by frame. The file is complete once Close() returned.
+class Mp4Writer {
+ public:
+  /// Opens `path` for `width` × `height` colour frames at `fps` with the first codec of
+  /// kMp4Codecs that the FFmpeg back end accepts. Throws InputError(kUnwritable) when none does.
+  Mp4Writer(const std::string& path, double fps, int width, int height);
+  ~Mp4Writer();
+  Mp4Writer(const Mp4Writer&) = delete;
+  Mp4Writer& operator=(const Mp4Writer&) = delete;
+
+  /// The FourCC in use ("avc1" or "mp4v").
+  const std::string& codec() const { return codec_; }
+
+  /// Appends a grey frame (values in [0, 1], clamped).
+  void WriteGrey(const Image& image);
+  /// Appends 8-bit BGR pixels, row-major, width × height × 3 bytes.
+  void WriteBgr(const unsigned char* pixels);
+  /// Finishes the file. Throws InputError(kUnwritable) when it cannot be finished.
+  void Close();
+
+ private:
+  std::string path_;
+  int width_, height_;
+  std::string codec_;
+  std::unique_ptr<cv::VideoWriter> writer_;
+};
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_VIDEO_WRITER_H_

@@ -1,0 +1,523 @@
+// The residual denoiser (issue 17): its speed and what it adds to the reconstruction.
+//
+//   denoiser_benchmark [--weights=FILE.onnx] [--data=../shared/data] [--parts=speed,quality]
+//                      [--runs=10] [--csv=FILE] [--out=PICTURE_DIR] [--cases=NAME,...]
+//                      [--pnp_iterations=N --pnp_rho=R --pnp_rho_growth=G]
+//
+// speed: ms per 240×180 frame (median of --runs) with 5 %, 25 % and 100 % of the pixels active
+//   (a centred rectangle), for one network on OpenCV's own threads and for one network per
+//   thread (DenoiserOptions::num_threads).
+// quality: the validation cases of issue 17, none of which the trainer may see: adobe240
+//   IMG_0004b and IMG_0036 (events simulated as `evfs simulate` does) interpolated (frame 2 from
+//   0 and 4) and deblurred (the mean of frames 0–7), slider_depth prediction, shapes_rotation
+//   interpolation (frame 3 from 2 and 4) and eslnet_cups deblur (no truth: re-blur PSNR and
+//   sharpness). Rows: the model-based reconstruction alone (DMR), DMR + the residual denoiser
+//   applied once (RD) and in plug & play (app/plug_and_play.h), and DMR + two generic
+//   denoisers with their strength tuned on the truth (OpenCV's fastNlMeansDenoising and its
+//   TV-L1 denoiser, run on the scored frames only), PSNR / SSIM and ms per frame. With --out, a
+//   picture per case (DMR | DMR + RD | truth, a zoomed crop below), as the paper's Fig. 7.
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/photo.hpp>
+#include <string>
+#include <vector>
+
+#include "app/denoise_job.h"
+#include "app/method.h"
+#include "app/plug_and_play.h"
+#include "app/reconstruct_job.h"
+#include "benchmarks/benchmark_cases.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "denoiser/denoiser.h"
+#include "io/data_source.h"
+
+DEFINE_string(weights, "", "The denoiser's ONNX file; empty: the shipped weights.");
+DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
+DEFINE_string(parts, "speed,quality", "speed, quality or both.");
+DEFINE_int32(runs, 10, "Runs per speed measurement (the median is reported).");
+DEFINE_int32(threads, 2, "Threads of the one-network-per-thread rows.");
+DEFINE_string(csv, "", "Also write the quality rows as CSV to this file.");
+DEFINE_string(out, "",
+              "Write a picture per quality case (DMR | DMR + RD | truth, a zoomed crop below) "
+              "as PNG into this folder.");
+DEFINE_string(cases, "",
+              "Only the quality cases whose name contains one of these (comma list); empty: all.");
+DEFINE_int32(pnp_iterations, evfs::PlugAndPlayOptions().iterations,
+             "Plug & play: ADMM iterations.");
+DEFINE_double(pnp_rho, evfs::PlugAndPlayOptions().initial_rho,
+              "Plug & play: rho of the first x-update.");
+DEFINE_double(pnp_rho_growth, evfs::PlugAndPlayOptions().rho_growth,
+              "Plug & play: rho's factor per iteration.");
+DEFINE_int32(pnp_solver_iterations, evfs::PlugAndPlayOptions().solver_iterations,
+             "Plug & play: LM iterations per x-update.");
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kSpeedWidth = 240;
+constexpr int kSpeedHeight = 180;
+constexpr int kSpeedFrames = 8;
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string WeightsPath() {
+  const std::string path = FLAGS_weights.empty() ? ShippedDenoiserWeights() : FLAGS_weights;
+  if (path.empty()) {
+    throw InvalidArgumentError("no shipped denoiser weights in this build: pass --weights");
+  }
+  return path;
+}
+
+// A smooth random-looking video (its content does not change the cost of a convolution).
+Video SpeedVideo() {
+  Video video(kSpeedHeight, kSpeedWidth, kSpeedFrames);
+  for (int t = 0; t < kSpeedFrames; ++t) {
+    for (int y = 0; y < kSpeedHeight; ++y) {
+      for (int x = 0; x < kSpeedWidth; ++x) {
+        video.at(t, y, x) = 0.5 + 0.4 * std::sin(0.05 * x + 0.3 * t) * std::cos(0.07 * y);
+      }
+    }
+  }
+  return video;
+}
+
+// A centred rectangle of `fraction` of the frame, with the frame's aspect ratio.
+DenoiseRegion CentredRegion(double fraction) {
+  DenoiseRegion region;
+  region.pixels.assign(kSpeedWidth * kSpeedHeight, 0);
+  const int w = static_cast<int>(std::lround(kSpeedWidth * std::sqrt(fraction)));
+  const int h = static_cast<int>(std::lround(kSpeedHeight * std::sqrt(fraction)));
+  const int x0 = (kSpeedWidth - w) / 2, y0 = (kSpeedHeight - h) / 2;
+  for (int y = y0; y < y0 + h; ++y) {
+    for (int x = x0; x < x0 + w; ++x) region.pixels[y * kSpeedWidth + x] = 1;
+  }
+  return region;
+}
+
+void RunSpeed() {
+  const Video video = SpeedVideo();
+  std::printf("\n## Denoiser speed: %s, %dx%d frames, median of %d runs of %d frames\n\n",
+              WeightsPath().c_str(), kSpeedWidth, kSpeedHeight, FLAGS_runs, kSpeedFrames);
+  std::printf("| active area | threads | networks | ms per frame | network pixels per frame |\n");
+  std::printf("| --- | --- | --- | --- | --- |\n");
+  for (const int networks : {1, FLAGS_threads}) {
+    DenoiserOptions options;
+    options.weights_path = WeightsPath();
+    options.num_threads = networks;
+    const Denoiser denoiser(options);
+    // One network: OpenCV parallelises each convolution over the threads itself. Several: each
+    // network runs on one thread, frames and tiles side by side.
+    cv::setNumThreads(networks == 1 ? FLAGS_threads : 1);
+    for (const double fraction : {0.05, 0.25, 1.0}) {
+      const DenoiseRegion region = CentredRegion(fraction);
+      std::vector<double> ms;
+      DenoiseStats stats;
+      denoiser.Apply(video, region, &stats);  // warm-up: allocation of the layers' buffers
+      for (int run = 0; run < FLAGS_runs; ++run) {
+        const auto start = Clock::now();
+        denoiser.Apply(video, region, &stats);
+        ms.push_back(1e3 * SecondsSince(start) / kSpeedFrames);
+      }
+      std::printf("| %.0f %% | %d | %d | %.2f | %lld |\n", 100 * fraction, FLAGS_threads, networks,
+                  Median(ms), static_cast<long long>(stats.network_pixels / kSpeedFrames));
+    }
+  }
+  cv::setNumThreads(-1);
+}
+
+// ---- quality ----
+
+struct Score {
+  double first = 0.0, second = 0.0;  // PSNR and SSIM (cups: re-blur PSNR and sharpness ×1e3)
+};
+
+// A validation case: the DMR, DMR + RD once and DMR + RD plug & play videos, and how a video is
+// scored.
+struct QualityCase {
+  std::string name;
+  std::string metrics;  // "PSNR / SSIM" or the cups metrics
+  bool has_truth = true;
+  Video dmr, rd, pnp;
+  double rd_ms_per_frame = 0.0;
+  double pnp_s = 0.0;  // the ADMM iterations: x-updates and denoising
+  // The latent frames the score reads: the truth-tuned generic denoisers filter only these
+  // (the score does not see the others). Empty: every frame.
+  std::vector<int> scored_frames;
+  std::function<Score(const Video&)> score;
+  // The picture: latent frame `picture_frame` next to `reference` (the truth, or the blurred
+  // input when there is none), labelled `reference_label`.
+  int picture_frame = 0;
+  Image reference;
+  std::string reference_label;
+};
+
+PlugAndPlayOptions PnpFromFlags() {
+  PlugAndPlayOptions pnp;
+  pnp.iterations = FLAGS_pnp_iterations;
+  pnp.initial_rho = FLAGS_pnp_rho;
+  pnp.rho_growth = FLAGS_pnp_rho_growth;
+  pnp.solver_iterations = FLAGS_pnp_solver_iterations;
+  return pnp;
+}
+
+// Applies an 8-bit OpenCV denoiser to the `frames` of `video` (empty: all), keeping the float
+// precision of the input: the denoiser's change of the quantised frame is added to the frame.
+// Other frames are copied unchanged.
+Video Apply8Bit(const Video& video, const std::vector<int>& frames,
+                const std::function<void(const cv::Mat&, cv::Mat&)>& filter, double* ms_per_frame) {
+  Video output = video;
+  std::vector<int> selected = frames;
+  if (selected.empty()) {
+    for (int t = 0; t < video.num_frames(); ++t) selected.push_back(t);
+  }
+  const auto start = Clock::now();
+  for (const int t : selected) {
+    cv::Mat frame(video.height(), video.width(), CV_64F, const_cast<double*>(video.frame_data(t)));
+    cv::Mat quantised, filtered;
+    frame.convertTo(quantised, CV_8U, 255.0);
+    filter(quantised, filtered);
+    cv::Mat change;
+    cv::subtract(filtered, quantised, change, cv::noArray(), CV_64F);
+    cv::Mat out(video.height(), video.width(), CV_64F, output.frame_data(t));
+    out = frame + change / 255.0;
+  }
+  *ms_per_frame = 1e3 * SecondsSince(start) / std::max<size_t>(1, selected.size());
+  return output;
+}
+
+// The best score of `filter` over `strengths` on the truth; `best` receives that strength.
+Score TuneOnTruth(const QualityCase& c, const std::vector<double>& strengths,
+                  const std::function<void(const cv::Mat&, cv::Mat&, double)>& filter, double* best,
+                  double* ms_per_frame) {
+  Score best_score{-1e9, 0.0};
+  for (const double strength : strengths) {
+    double ms = 0.0;
+    const Video filtered = Apply8Bit(
+        c.dmr, c.scored_frames, [&](const cv::Mat& in, cv::Mat& out) { filter(in, out, strength); },
+        &ms);
+    const Score score = c.score(filtered);
+    if (score.first > best_score.first) {
+      best_score = score;
+      *best = strength;
+      *ms_per_frame = ms;
+    }
+  }
+  return best_score;
+}
+
+Score ScoreFrame(const Video& latent, int64_t t_ns, const Image& truth) {
+  const Image estimate = latent.frame(latent.NearestFrame(t_ns));
+  return {Psnr(estimate, truth), Ssim(estimate, truth)};
+}
+
+// A case on a DAVIS snippet, through RunReconstruction as `evfs reconstruct` runs it (once per
+// denoising mode: the job does not hand out its scene).
+QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last, int truth) {
+  ReconstructRequest request;
+  request.data_path = (fs::path(FLAGS_data) / snippet).string();
+  request.mode = mode;
+  request.first = first;
+  request.last = last;
+  request.truth = truth;
+  QualityCase c;
+  c.name = snippet + " " + ModeName(mode);
+  request.denoise.mode = DenoiseMode::kNone;
+  c.dmr = RunReconstruction(request).run.video;
+  request.denoise.denoiser.weights_path = WeightsPath();
+  request.denoise.mode = DenoiseMode::kOnce;
+  const ReconstructResult with_rd = RunReconstruction(request);
+  c.rd = with_rd.run.video;
+  c.rd_ms_per_frame = 1e3 * with_rd.denoise.stats.time_s / std::max(1, c.rd.num_frames());
+  request.denoise.mode = DenoiseMode::kPnp;
+  request.denoise.pnp = PnpFromFlags();
+  const ReconstructResult with_pnp = RunReconstruction(request);
+  c.pnp = with_pnp.run.video;
+  c.pnp_s = with_pnp.denoise.pnp.solve_time_s + with_pnp.denoise.pnp.denoise_time_s;
+  const auto source = DataSource::Open(request.data_path);
+  if (truth >= 0) {
+    c.metrics = "PSNR / SSIM (frame " + std::to_string(truth) + ")";
+    const Image truth_image = source->ReadImage(truth);
+    const int64_t t_ns = source->frames()[truth].t_ns;
+    c.score = [truth_image, t_ns](const Video& video) {
+      return ScoreFrame(video, t_ns, truth_image);
+    };
+    c.picture_frame = c.dmr.NearestFrame(t_ns);
+    c.scored_frames = {c.picture_frame};
+    c.reference = truth_image;
+    c.reference_label = "truth";
+  } else {
+    c.has_truth = false;
+    c.metrics = "re-blur PSNR / sharpness x1e3";
+    const Image blurred = source->ReadImage(first);
+    c.score = [blurred](const Video& video) {
+      const DeblurWithoutTruthScore score = ScoreDeblurWithoutTruth(video, blurred);
+      return Score{score.mean_vs_input_psnr, 1e3 * score.latent_sharpness};
+    };
+    c.picture_frame = c.dmr.num_frames() / 2;
+    c.reference = blurred;
+    c.reference_label = "blurred input";
+  }
+  return c;
+}
+
+// A case on a 240 fps clip with simulated events, through RunMethod on the scene.
+QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& denoiser) {
+  const SimulatedClip clip = LoadSimulatedClip(FLAGS_data, clip_name);
+  const BinningOptions binning;
+  const Scene scene =
+      deblur ? MakeClipDeblurScene(clip, binning) : MakeClipInterpolationScene(clip, binning);
+  const MethodOptions method;
+  const MethodResult run = RunMethod(scene, method);
+  QualityCase c;
+  c.name = clip_name + (deblur ? " deblur" : " interpolate");
+  c.dmr = run.video;
+  const DenoiseRegion region = SolvedRegion(scene, method, run.solved);
+  DenoiseStats stats;
+  c.rd = denoiser.Apply(run.video, region, &stats);
+  c.rd_ms_per_frame = 1e3 * stats.time_s / std::max(1, c.rd.num_frames());
+  MethodResult pnp_run = run;
+  const DenoiseRecord pnp = PlugAndPlayLatentVideo(denoiser, scene, method, PnpFromFlags(), region,
+                                                   nullptr, -1, &pnp_run);
+  c.pnp = std::move(pnp_run.video);
+  c.pnp_s = pnp.pnp.solve_time_s + pnp.pnp.denoise_time_s;
+  if (deblur) {
+    c.metrics = "PSNR / SSIM (mean over frames 0-7)";
+    c.score = [frames = clip.frames](const Video& video) {
+      SimulatedClip reference;  // ScoreClipDeblur reads only the frames
+      reference.frames = frames;
+      return Score{ScoreClipDeblur(video, reference, Psnr),
+                   ScoreClipDeblur(video, reference, Ssim)};
+    };
+    for (int t = 0; t < kClipFrames; ++t) {
+      c.scored_frames.push_back(c.dmr.NearestFrame(clip.frames.timestamp_ns(t)));
+    }
+    std::sort(c.scored_frames.begin(), c.scored_frames.end());
+    c.scored_frames.erase(std::unique(c.scored_frames.begin(), c.scored_frames.end()),
+                          c.scored_frames.end());
+    c.picture_frame = c.dmr.NearestFrame(clip.frames.timestamp_ns(kClipFrames / 2));
+    c.reference = clip.frames.frame(kClipFrames / 2);
+  } else {
+    c.metrics = "PSNR / SSIM (frame 2)";
+    const Image truth = clip.frames.frame(kClipTruthFrame);
+    const int64_t t_ns = clip.frames.timestamp_ns(kClipTruthFrame);
+    c.score = [truth, t_ns](const Video& video) { return ScoreFrame(video, t_ns, truth); };
+    c.picture_frame = c.dmr.NearestFrame(t_ns);
+    c.scored_frames = {c.picture_frame};
+    c.reference = truth;
+  }
+  c.reference_label = "truth";
+  return c;
+}
+
+cv::Mat ToBgr8(const Image& image) {
+  cv::Mat grey(static_cast<int>(image.rows()), static_cast<int>(image.cols()), CV_8U);
+  for (int y = 0; y < grey.rows; ++y) {
+    for (int x = 0; x < grey.cols; ++x) {
+      grey.at<uint8_t>(y, x) =
+          cv::saturate_cast<uint8_t>(std::lround(255.0 * std::clamp(image(y, x), 0.0, 1.0)));
+    }
+  }
+  cv::Mat bgr;
+  cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+  return bgr;
+}
+
+// The case's picture, as the paper's Fig. 7: DMR | DMR + RD | reference on top, and below each
+// the same square crop zoomed, where the denoiser changed the frame most (outlined in red).
+void WritePicture(const QualityCase& c, const std::string& folder) {
+  const Image dmr = c.dmr.frame(c.picture_frame), rd = c.rd.frame(c.picture_frame);
+  const int height = static_cast<int>(dmr.rows()), width = static_cast<int>(dmr.cols());
+  const int side = std::max(8, std::min(height, width) / 3);
+  // Where |RD − DMR| summed over a crop is largest.
+  cv::Mat change(height, width, CV_64F);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) change.at<double>(y, x) = std::abs(rd(y, x) - dmr(y, x));
+  }
+  cv::Mat summed;
+  cv::boxFilter(change, summed, CV_64F, cv::Size(side, side), cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
+  const cv::Rect inner(side / 2, side / 2, width - side + 1, height - side + 1);
+  cv::Point best;
+  cv::minMaxLoc(summed(inner), nullptr, nullptr, nullptr, &best);
+  const cv::Rect crop(best.x, best.y, side, side);
+
+  constexpr int kLabelPx = 18;
+  const std::vector<std::pair<std::string, Image>> panels = {
+      {"DMR", dmr}, {"DMR + RD", rd}, {c.reference_label, c.reference}};
+  cv::Mat canvas(kLabelPx + height + width, 3 * width, CV_8UC3, cv::Scalar(255, 255, 255));
+  for (size_t i = 0; i < panels.size(); ++i) {
+    const int x0 = static_cast<int>(i) * width;
+    const cv::Mat panel = ToBgr8(panels[i].second);
+    cv::putText(canvas, panels[i].first, cv::Point(x0 + 4, kLabelPx - 5), cv::FONT_HERSHEY_SIMPLEX,
+                0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    cv::Mat zoomed;
+    cv::resize(panel(crop), zoomed, cv::Size(width, width), 0, 0, cv::INTER_NEAREST);
+    panel.copyTo(canvas(cv::Rect(x0, kLabelPx, width, height)));
+    cv::rectangle(canvas, cv::Rect(x0 + crop.x, kLabelPx + crop.y, crop.width, crop.height),
+                  cv::Scalar(0, 0, 255), 1);
+    zoomed.copyTo(canvas(cv::Rect(x0, kLabelPx + height, width, width)));
+  }
+  std::string file = c.name;
+  std::replace(file.begin(), file.end(), ' ', '_');
+  const fs::path path = fs::path(folder) / (file + ".png");
+  if (!cv::imwrite(path.string(), canvas)) {
+    throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "cannot write the picture");
+  }
+}
+
+bool Wanted(const std::string& name) {
+  if (FLAGS_cases.empty()) return true;
+  for (const std::string& part : SplitCommaList(FLAGS_cases)) {
+    if (name.find(part) != std::string::npos) return true;
+  }
+  return false;
+}
+
+void RunQuality() {
+  if (FLAGS_data.empty() || !fs::is_directory(FLAGS_data)) {
+    std::printf("\nquality: no data folder (--data); skipped\n");
+    return;
+  }
+  if (!FLAGS_out.empty()) fs::create_directories(FLAGS_out);
+  DenoiserOptions options;
+  options.weights_path = WeightsPath();
+  const Denoiser denoiser(options);
+  const PlugAndPlayOptions pnp = PnpFromFlags();
+  std::string error;
+  if (!pnp.IsValid(&error)) throw InvalidArgumentError("plug & play flags: " + error);
+
+  std::printf("\n## Denoiser quality: %s (sha256 %s)\n\n", denoiser.weights_path().c_str(),
+              denoiser.weights_sha256().c_str());
+  std::printf("plug & play: %d iterations, rho %g x %g, %d LM iterations per x-update\n\n",
+              pnp.iterations, pnp.initial_rho, pnp.rho_growth, pnp.solver_iterations);
+  std::printf(
+      "| case | metrics | DMR | DMR + RD once | once gain dB | DMR + RD pnp | pnp gain dB | "
+      "fastNlMeans (h) | TV-L1 (lambda) | ms/frame RD, NLM, TV | pnp s |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  std::fflush(stdout);
+  std::ofstream csv;
+  if (!FLAGS_csv.empty()) {
+    csv.open(FLAGS_csv);
+    csv << "case,metrics,dmr_1,dmr_2,rd_1,rd_2,pnp_1,pnp_2,nlm_1,nlm_2,nlm_h,tv_1,tv_2,tv_lambda,"
+           "rd_ms,nlm_ms,tv_ms,pnp_s\n";
+  }
+
+  std::vector<std::function<QualityCase()>> makers;
+  std::vector<std::string> names;
+  for (const std::string clip : {"adobe240_IMG_0004b", "adobe240_IMG_0036"}) {
+    for (const bool deblur : {false, true}) {
+      names.push_back(clip + (deblur ? " deblur" : " interpolate"));
+      makers.push_back([clip, deblur, &denoiser] { return ClipCase(clip, deblur, denoiser); });
+    }
+  }
+  names.push_back("slider_depth_70_71 predict");
+  makers.push_back([] { return DavisCase("slider_depth_70_71", Mode::kPredict, 0, 1, 1); });
+  names.push_back("shapes_rotation_13_20 interpolate");
+  makers.push_back([] { return DavisCase("shapes_rotation_13_20", Mode::kInterpolate, 2, 4, 3); });
+  names.push_back("eslnet_cups_blur deblur");
+  makers.push_back([] { return DavisCase("eslnet_cups_blur", Mode::kDeblur, 1, -1, -1); });
+
+  // Gains over DMR on the cases with a truth.
+  std::vector<double> once_gain, pnp_gain, nlm_gain;
+  for (size_t i = 0; i < makers.size(); ++i) {
+    if (!Wanted(names[i])) continue;
+    const QualityCase c = makers[i]();
+    const Score dmr = c.score(c.dmr), rd = c.score(c.rd), pnp_score = c.score(c.pnp);
+    double h = 0.0, lambda = 0.0, nlm_ms = 0.0, tv_ms = 0.0;
+    Score nlm, tv;
+    if (c.has_truth) {
+      nlm = TuneOnTruth(
+          c, {1, 2, 3, 5, 7, 10, 15},
+          [](const cv::Mat& in, cv::Mat& out, double strength) {
+            cv::fastNlMeansDenoising(in, out, static_cast<float>(strength));
+          },
+          &h, &nlm_ms);
+      tv = TuneOnTruth(
+          c, {0.25, 0.5, 1.0, 2.0, 4.0},
+          [](const cv::Mat& in, cv::Mat& out, double strength) {
+            cv::denoise_TVL1({in}, out, strength, 30);
+          },
+          &lambda, &tv_ms);
+      once_gain.push_back(rd.first - dmr.first);
+      pnp_gain.push_back(pnp_score.first - dmr.first);
+      nlm_gain.push_back(nlm.first - dmr.first);
+      std::printf(
+          "| %s | %s | %.2f / %.4f | %.2f / %.4f | %+.2f | %.2f / %.4f | %+.2f | %.2f / %.4f (%g) "
+          "| %.2f / %.4f (%g) | %.1f, %.1f, %.1f | %.1f |\n",
+          c.name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
+          rd.first - dmr.first, pnp_score.first, pnp_score.second, pnp_score.first - dmr.first,
+          nlm.first, nlm.second, h, tv.first, tv.second, lambda, c.rd_ms_per_frame, nlm_ms, tv_ms,
+          c.pnp_s);
+    } else {
+      // No truth to tune the generic denoisers on.
+      std::printf(
+          "| %s | %s | %.2f / %.2f | %.2f / %.2f | %+.2f | %.2f / %.2f | %+.2f | n/a | n/a | "
+          "%.1f, -, - | %.1f |\n",
+          c.name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
+          rd.first - dmr.first, pnp_score.first, pnp_score.second, pnp_score.first - dmr.first,
+          c.rd_ms_per_frame, c.pnp_s);
+    }
+    if (csv) {
+      csv << c.name << "," << c.metrics << "," << dmr.first << "," << dmr.second << "," << rd.first
+          << "," << rd.second << "," << pnp_score.first << "," << pnp_score.second << ","
+          << nlm.first << "," << nlm.second << "," << h << "," << tv.first << "," << tv.second
+          << "," << lambda << "," << c.rd_ms_per_frame << "," << nlm_ms << "," << tv_ms << ","
+          << c.pnp_s << "\n";
+    }
+    if (!FLAGS_out.empty()) WritePicture(c, FLAGS_out);
+    std::fflush(stdout);
+  }
+  const auto summary = [](const char* label, const std::vector<double>& gains) {
+    if (gains.empty()) return;
+    double mean = 0.0;
+    for (const double gain : gains) mean += gain / gains.size();
+    std::printf("%s: mean gain over DMR %+.2f dB, worst case %+.2f dB (%zu cases with a truth)\n",
+                label, mean, *std::min_element(gains.begin(), gains.end()), gains.size());
+  };
+  std::printf("\n");
+  summary("DMR + RD once", once_gain);
+  summary("DMR + RD pnp", pnp_gain);
+  summary("DMR + fastNlMeans (tuned on the truth)", nlm_gain);
+}
+
+}  // namespace
+}  // namespace evfs
+
+int main(int argc, char** argv) {
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  google::InitGoogleLogging(argv[0]);
+  try {
+    const std::vector<std::string> parts = evfs::SplitCommaList(FLAGS_parts);
+    const auto wants = [&parts](const char* part) {
+      return std::find(parts.begin(), parts.end(), part) != parts.end();
+    };
+    if (wants("speed")) evfs::RunSpeed();
+    if (wants("quality")) evfs::RunQuality();
+  } catch (const evfs::Error& error) {
+    std::fprintf(stderr, "denoiser_benchmark: %s\n", error.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,158 @@
+#include "python/array_source.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/time.h"
+
+namespace evfs {
+namespace {
+
+// Largest sensor side: event coordinates are uint16.
+constexpr int kMaxSensorSide = 65536;
+// Largest |time| in seconds that int64 nanoseconds hold with room to spare (2^63 ns ≈ 9.2e9 s).
+constexpr double kMaxAbsTimeS = 9.0e9;
+
+std::vector<FrameInfo> FrameInfos(const RecordingArrays& arrays) {
+  std::vector<FrameInfo> frames(arrays.num_frames);
+  for (int i = 0; i < arrays.num_frames; ++i) {
+    FrameInfo& frame = frames[i];
+    frame.t_ns = arrays.frame_t_ns[i];
+    frame.path = "frame " + std::to_string(i);
+    if (!arrays.has_exposure.empty() && arrays.has_exposure[i]) {
+      frame.has_exposure = true;
+      frame.exposure_begin_ns = arrays.exposure_begin_ns[i];
+      frame.exposure_end_ns = arrays.exposure_end_ns[i];
+    }
+  }
+  return frames;
+}
+
+double FrameValue(const RecordingArrays& arrays, size_t i) {
+  return arrays.frames_float32 != nullptr ? static_cast<double>(arrays.frames_float32[i])
+                                          : arrays.frames_float64[i];
+}
+
+}  // namespace
+
+int64_t CheckedNanoseconds(double t_s, const std::string& what) {
+  if (!(std::fabs(t_s) <= kMaxAbsTimeS)) {
+    throw InvalidArgumentError(what + " is " + std::to_string(t_s) +
+                               ": times must be finite seconds within +-9e9");
+  }
+  return SecondsToNanoseconds(t_s);
+}
+
+void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& frames_name,
+                          const std::string& events_name) {
+  const auto fail = [](const std::string& message) { throw InvalidArgumentError(message); };
+  if (arrays.num_frames < 1 || arrays.height < 1 || arrays.width < 1) {
+    fail(frames_name + " must hold at least one frame of at least 1x1 pixels");
+  }
+  if (arrays.height > kMaxSensorSide || arrays.width > kMaxSensorSide) {
+    fail(frames_name + " frames must be at most " + std::to_string(kMaxSensorSide) +
+         " pixels on a side (event coordinates are uint16)");
+  }
+  const size_t values = static_cast<size_t>(arrays.num_frames) * arrays.height * arrays.width;
+  for (size_t i = 0; i < values; ++i) {
+    const double value = FrameValue(arrays, i);
+    if (!(value >= 0.0 && value <= 1.0)) {
+      const size_t pixels = static_cast<size_t>(arrays.height) * arrays.width;
+      const size_t in_frame = i % pixels;
+      fail(frames_name + " must hold intensities in [0, 1]: [" + std::to_string(i / pixels) + ", " +
+           std::to_string(in_frame / arrays.width) + ", " +
+           std::to_string(in_frame % arrays.width) + "] is " + std::to_string(value));
+    }
+  }
+  if (arrays.frame_t_ns.size() != static_cast<size_t>(arrays.num_frames)) {
+    fail("frame_times must hold one time per frame: " + std::to_string(arrays.num_frames) +
+         " frames, " + std::to_string(arrays.frame_t_ns.size()) + " times");
+  }
+  for (int i = 1; i < arrays.num_frames; ++i) {
+    if (arrays.frame_t_ns[i] <= arrays.frame_t_ns[i - 1]) {
+      fail("frame_times must increase strictly: [" + std::to_string(i) + "] is not after [" +
+           std::to_string(i - 1) + "]");
+    }
+  }
+  if (!arrays.has_exposure.empty()) {
+    for (int i = 0; i < arrays.num_frames; ++i) {
+      if (arrays.has_exposure[i] && arrays.exposure_end_ns[i] < arrays.exposure_begin_ns[i]) {
+        fail("exposures[" + std::to_string(i) + "] ends before it begins");
+      }
+    }
+  }
+  double previous_t_s = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < arrays.num_events; ++i) {
+    const double t_s = arrays.event_t_s[i];
+    CheckedNanoseconds(t_s, events_name + "['t'][" + std::to_string(i) + "]");
+    if (t_s < previous_t_s) {
+      fail(events_name + "['t'] must be sorted: [" + std::to_string(i) + "] comes before [" +
+           std::to_string(i - 1) + "]");
+    }
+    previous_t_s = t_s;
+    if (arrays.event_x[i] >= arrays.width || arrays.event_y[i] >= arrays.height) {
+      fail(events_name + " event " + std::to_string(i) +
+           " at x=" + std::to_string(arrays.event_x[i]) +
+           ", y=" + std::to_string(arrays.event_y[i]) + " lies outside the " +
+           std::to_string(arrays.width) + "x" + std::to_string(arrays.height) + " frames");
+    }
+    const int polarity = arrays.event_polarity[i];
+    if (polarity != 1 && polarity != -1) {
+      fail(events_name + "['p'][" + std::to_string(i) + "] is " + std::to_string(polarity) +
+           ": polarities are +1 or -1");
+    }
+  }
+}
+
+ArraySource::ArraySource(const RecordingArrays& arrays, const std::string& label)
+    : DataSource(label, arrays.width, arrays.height, FrameInfos(arrays)), arrays_(arrays) {}
+
+Image ArraySource::ReadImage(int index) const {
+  if (index < 0 || index >= arrays_.num_frames) {
+    throw InvalidArgumentError("frame " + std::to_string(index) + " is out of range: " + path() +
+                               " has " + std::to_string(arrays_.num_frames) + " frames");
+  }
+  Image image(arrays_.height, arrays_.width);
+  const size_t offset = static_cast<size_t>(index) * arrays_.height * arrays_.width;
+  for (Eigen::Index i = 0; i < image.size(); ++i) image.data()[i] = FrameValue(arrays_, offset + i);
+  return image;
+}
+
+size_t ArraySource::LowerBound(int64_t t_ns) const {
+  // SecondsToNanoseconds is non-decreasing, so the converted times are sorted too.
+  const double* begin = arrays_.event_t_s;
+  const double* found = std::partition_point(begin, begin + arrays_.num_events, [t_ns](double t_s) {
+    return SecondsToNanoseconds(t_s) < t_ns;
+  });
+  return static_cast<size_t>(found - begin);
+}
+
+EventStream ArraySource::Copy(size_t first, size_t last) const {
+  EventStream events(arrays_.width, arrays_.height);
+  events.reserve(last - first);
+  for (size_t i = first; i < last; ++i) {
+    events.push_back(SecondsToNanoseconds(arrays_.event_t_s[i]), arrays_.event_x[i],
+                     arrays_.event_y[i], arrays_.event_polarity[i]);
+  }
+  return events;
+}
+
+EventStream ArraySource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
+  const size_t first = LowerBound(t_begin_ns);
+  return Copy(first, std::max(first, LowerBound(t_end_ns)));
+}
+
+EventStream ArraySource::ReadAllEvents() const { return Copy(0, arrays_.num_events); }
+
+EventSummary ArraySource::Summarize() const {
+  EventSummary summary;
+  for (size_t i = 0; i < arrays_.num_events; ++i) {
+    summary.Add(SecondsToNanoseconds(arrays_.event_t_s[i]), arrays_.event_x[i], arrays_.event_y[i],
+                arrays_.event_polarity[i]);
+  }
+  return summary;
+}
+
+}  // namespace evfs

@@ -1,0 +1,74 @@
+// A recording held in the caller's arrays (the Python module's NumPy inputs), seen through the
+// DataSource interface so that the reconstruction job reads it exactly as it reads a file.
+// Nothing is copied up front: a frame is converted when the job asks for it, and only the
+// events of the requested window are copied.
+#ifndef EVFS_PYTHON_ARRAY_SOURCE_H_
+#define EVFS_PYTHON_ARRAY_SOURCE_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/event_stream.h"
+#include "core/video.h"
+#include "io/data_source.h"
+
+namespace evfs {
+
+/// Borrowed arrays of a recording. Every pointer must stay valid, and its data unchanged, for
+/// the lifetime of the ArraySource made from it.
+struct RecordingArrays {
+  /// num_frames × height × width intensities in [0, 1], C order; exactly one of the two is set.
+  const float* frames_float32 = nullptr;
+  const double* frames_float64 = nullptr;
+  int num_frames = 0;
+  int height = 0;
+  int width = 0;
+  /// One timestamp per frame, strictly increasing.
+  std::vector<int64_t> frame_t_ns;
+  /// Per frame: exposure begin and end, or none (has_exposure false) when empty.
+  std::vector<bool> has_exposure;
+  std::vector<int64_t> exposure_begin_ns;
+  std::vector<int64_t> exposure_end_ns;
+  /// num_events events in time order: t in seconds (never decreasing), x < width, y < height,
+  /// polarity ±1.
+  const double* event_t_s = nullptr;
+  const uint16_t* event_x = nullptr;
+  const uint16_t* event_y = nullptr;
+  const int8_t* event_polarity = nullptr;
+  size_t num_events = 0;
+};
+
+/// `t_s` seconds as int64 nanoseconds (core/time.h); throws InvalidArgumentError naming `what`
+/// when it is not finite or beyond int64 nanoseconds (about 292 years).
+int64_t CheckedNanoseconds(double t_s, const std::string& what);
+
+/// Checks a RecordingArrays against the contract above and throws InvalidArgumentError naming
+/// the first thing that breaks it: `frames_name` and `events_name` are how the message calls
+/// the arrays (the Python argument names).
+void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& frames_name,
+                          const std::string& events_name);
+
+/// The DataSource over checked RecordingArrays. Frames are named "frame N" in messages and
+/// summaries; path() is `label`.
+class ArraySource : public DataSource {
+ public:
+  ArraySource(const RecordingArrays& arrays, const std::string& label);
+
+  Image ReadImage(int index) const override;
+  EventStream ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const override;
+  EventStream ReadAllEvents() const override;
+  EventSummary Summarize() const override;
+
+ private:
+  // Index of the first event with SecondsToNanoseconds(t) >= t_ns (binary search).
+  size_t LowerBound(int64_t t_ns) const;
+  EventStream Copy(size_t first, size_t last) const;
+
+  RecordingArrays arrays_;
+};
+
+}  // namespace evfs
+
+#endif  // EVFS_PYTHON_ARRAY_SOURCE_H_

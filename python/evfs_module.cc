@@ -1,0 +1,378 @@
+// The Python module `evfs`: recordings read into NumPy arrays, and the reconstruction and the
+// event simulator run on NumPy arrays, through the same application library as the command
+// line (app/). Errors that are the user's become ValueError with the command line's one-line
+// message, a failed solve RuntimeError. The GIL is released while evfs reads, solves and
+// simulates.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/reconstruct_job.h"
+#include "core/error.h"
+#include "core/event_stream.h"
+#include "core/time.h"
+#include "core/version.h"
+#include "core/video.h"
+#include "events/simulator.h"
+#include "io/data_source.h"
+#include "python/array_source.h"
+#include "python/reconstruct_options.h"
+
+namespace evfs {
+namespace {
+
+namespace py = pybind11;
+
+// How summaries and messages name a recording given as arrays.
+constexpr char kArraysLabel[] = "the frames array";
+
+std::string TypeName(py::handle object) {
+  return py::str(py::type::handle_of(object).attr("__name__"));
+}
+
+std::string DtypeName(const py::array& array) { return py::str(array.dtype()); }
+
+// `object` as a NumPy array of exactly dtype T with `ndim` dimensions, C-contiguous: the array
+// itself when it is one (no copy), a contiguous copy when only the layout differs. Any other
+// dtype is refused rather than converted, so that no value is silently changed.
+template <typename T>
+py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
+                                                const std::string& name) {
+  const std::string expected =
+      std::to_string(ndim) + "-D " + std::string(py::str(py::dtype::of<T>()));
+  if (!py::isinstance<py::array>(object)) {
+    throw InvalidArgumentError(name + " must be a NumPy array (" + expected + "), not " +
+                               TypeName(object));
+  }
+  const py::array array = py::reinterpret_borrow<py::array>(object);
+  if (!array.dtype().is(py::dtype::of<T>())) {
+    throw InvalidArgumentError(name + " must be a " + expected + " array, not " + DtypeName(array) +
+                               ": convert it with .astype(numpy." +
+                               std::string(py::str(py::dtype::of<T>())) + ")");
+  }
+  if (array.ndim() != ndim) {
+    throw InvalidArgumentError(name + " must be a " + expected + " array, not " +
+                               std::to_string(array.ndim()) + "-D");
+  }
+  return py::array_t<T, py::array::c_style>::ensure(array);
+}
+
+// Inputs of reconstruct and simulate, kept alive (and referenced by `recording`) for the call.
+struct RecordingInput {
+  py::array frames;
+  py::array_t<double, py::array::c_style> frame_times;
+  py::array_t<double, py::array::c_style> event_t;
+  py::array_t<uint16_t, py::array::c_style> event_x, event_y;
+  py::array_t<int8_t, py::array::c_style> event_p;
+  RecordingArrays recording;
+};
+
+void SetFrames(py::handle frames_object, RecordingInput* input) {
+  if (!py::isinstance<py::array>(frames_object)) {
+    throw InvalidArgumentError("frames must be a NumPy array (3-D float32 or float64), not " +
+                               TypeName(frames_object));
+  }
+  const py::array frames = py::reinterpret_borrow<py::array>(frames_object);
+  RecordingArrays& recording = input->recording;
+  if (frames.dtype().is(py::dtype::of<float>())) {
+    const auto checked = CheckedArray<float>(frames, 3, "frames");
+    recording.frames_float32 = checked.data();
+    input->frames = checked;
+  } else if (frames.dtype().is(py::dtype::of<double>())) {
+    const auto checked = CheckedArray<double>(frames, 3, "frames");
+    recording.frames_float64 = checked.data();
+    input->frames = checked;
+  } else {
+    throw InvalidArgumentError(
+        "frames must be a 3-D float32 or float64 array (frames x height "
+        "x width, intensities in [0, 1]), not " +
+        DtypeName(frames));
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    if (input->frames.shape(axis) > std::numeric_limits<int>::max()) {
+      throw InvalidArgumentError("frames is too large");
+    }
+  }
+  recording.num_frames = static_cast<int>(input->frames.shape(0));
+  recording.height = static_cast<int>(input->frames.shape(1));
+  recording.width = static_cast<int>(input->frames.shape(2));
+}
+
+void SetFrameTimes(py::handle times_object, RecordingInput* input) {
+  input->frame_times = CheckedArray<double>(times_object, 1, "frame_times");
+  const auto times = input->frame_times.unchecked<1>();
+  for (py::ssize_t i = 0; i < times.shape(0); ++i) {
+    input->recording.frame_t_ns.push_back(
+        CheckedNanoseconds(times(i), "frame_times[" + std::to_string(i) + "]"));
+  }
+}
+
+// exposures: None, or frames × 2 (begin, end) in seconds with NaN rows for frames without one.
+void SetExposures(py::handle exposures_object, RecordingInput* input) {
+  if (exposures_object.is_none()) return;
+  const auto exposures = CheckedArray<double>(exposures_object, 2, "exposures");
+  RecordingArrays& recording = input->recording;
+  if (exposures.shape(0) != recording.num_frames || exposures.shape(1) != 2) {
+    throw InvalidArgumentError(
+        "exposures must be a frames x 2 array (begin, end in seconds; NaN "
+        "where a frame has none): " +
+        std::to_string(recording.num_frames) + " x 2 here");
+  }
+  const auto view = exposures.unchecked<2>();
+  for (int i = 0; i < recording.num_frames; ++i) {
+    const bool known = !std::isnan(view(i, 0)) || !std::isnan(view(i, 1));
+    const std::string what = "exposures[" + std::to_string(i) + "]";
+    recording.has_exposure.push_back(known);
+    recording.exposure_begin_ns.push_back(known ? CheckedNanoseconds(view(i, 0), what) : 0);
+    recording.exposure_end_ns.push_back(known ? CheckedNanoseconds(view(i, 1), what) : 0);
+  }
+}
+
+// events: a dict of 1-D arrays t (float64 seconds), x, y (uint16), p (int8, ±1), as evfs.read
+// returns them.
+void SetEvents(py::handle events_object, RecordingInput* input) {
+  if (!py::isinstance<py::dict>(events_object)) {
+    throw InvalidArgumentError(
+        "events must be a dict of arrays 't' (float64 seconds), 'x', 'y' "
+        "(uint16) and 'p' (int8, +1 or -1), not " +
+        TypeName(events_object));
+  }
+  const py::dict events = py::reinterpret_borrow<py::dict>(events_object);
+  for (const char* key : {"t", "x", "y", "p"}) {
+    if (!events.contains(key)) {
+      throw InvalidArgumentError(std::string("events has no '") + key +
+                                 "': expected arrays 't', 'x', 'y' and 'p'");
+    }
+  }
+  input->event_t = CheckedArray<double>(events["t"], 1, "events['t']");
+  input->event_x = CheckedArray<uint16_t>(events["x"], 1, "events['x']");
+  input->event_y = CheckedArray<uint16_t>(events["y"], 1, "events['y']");
+  input->event_p = CheckedArray<int8_t>(events["p"], 1, "events['p']");
+  const py::ssize_t count = input->event_t.shape(0);
+  if (input->event_x.shape(0) != count || input->event_y.shape(0) != count ||
+      input->event_p.shape(0) != count) {
+    throw InvalidArgumentError("events['t'], ['x'], ['y'] and ['p'] must have the same length");
+  }
+  RecordingArrays& recording = input->recording;
+  recording.event_t_s = input->event_t.data();
+  recording.event_x = input->event_x.data();
+  recording.event_y = input->event_y.data();
+  recording.event_polarity = input->event_p.data();
+  recording.num_events = static_cast<size_t>(count);
+}
+
+// A NumPy array over `values`, which it keeps alive: no copy.
+template <typename T>
+py::array_t<T> OwningArray(std::vector<T>&& values) {
+  auto* owned = new std::vector<T>(std::move(values));
+  const py::capsule free_when_done(owned, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(static_cast<py::ssize_t>(owned->size()), owned->data(), free_when_done);
+}
+
+py::array_t<double> Seconds(const std::vector<int64_t>& t_ns) {
+  py::array_t<double> seconds(static_cast<py::ssize_t>(t_ns.size()));
+  double* out = seconds.mutable_data();
+  for (size_t i = 0; i < t_ns.size(); ++i) out[i] = NanosecondsToSeconds(t_ns[i]);
+  return seconds;
+}
+
+py::dict EventsDict(EventStream events) {
+  py::dict dict;
+  dict["t"] = Seconds(events.t_ns());
+  std::vector<uint16_t> x = events.x(), y = events.y();
+  std::vector<int8_t> p = events.polarity();
+  events.clear();
+  dict["x"] = OwningArray(std::move(x));
+  dict["y"] = OwningArray(std::move(y));
+  dict["p"] = OwningArray(std::move(p));
+  return dict;
+}
+
+// The frames of `video` as a frames × height × width array of `dtype` ("float32": converted;
+// "float64": the video's own values, without a copy).
+py::array VideoArray(Video&& video, const std::string& dtype) {
+  const std::vector<py::ssize_t> shape = {video.num_frames(), video.height(), video.width()};
+  if (dtype == "float64") {
+    auto* owned = new Video(std::move(video));
+    const py::capsule free_when_done(owned, [](void* p) { delete static_cast<Video*>(p); });
+    return py::array_t<double>(shape, owned->data(), free_when_done);
+  }
+  py::array_t<float> frames(shape);
+  float* out = frames.mutable_data();
+  const size_t values = static_cast<size_t>(video.num_frames()) * video.pixels_per_frame();
+  for (size_t i = 0; i < values; ++i) out[i] = static_cast<float>(video.data()[i]);
+  return std::move(frames);
+}
+
+py::dict ReadArrays(const std::string& path) {
+  std::unique_ptr<DataSource> source;
+  {
+    py::gil_scoped_release release;
+    source = DataSource::Open(path);
+  }
+  const std::vector<FrameInfo>& frames = source->frames();
+  const int num_frames = static_cast<int>(frames.size());
+  py::array_t<double> images(
+      std::vector<py::ssize_t>{num_frames, source->height(), source->width()});
+  py::array_t<double> exposures(std::vector<py::ssize_t>{num_frames, 2});
+  std::vector<int64_t> frame_t_ns;
+  py::list frame_paths;
+  auto exposure_view = exposures.mutable_unchecked<2>();
+  for (int i = 0; i < num_frames; ++i) {
+    frame_t_ns.push_back(frames[i].t_ns);
+    frame_paths.append(frames[i].path);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    exposure_view(i, 0) =
+        frames[i].has_exposure ? NanosecondsToSeconds(frames[i].exposure_begin_ns) : nan;
+    exposure_view(i, 1) =
+        frames[i].has_exposure ? NanosecondsToSeconds(frames[i].exposure_end_ns) : nan;
+  }
+  double* image_data = images.mutable_data();
+  EventStream events(source->width(), source->height());
+  {
+    py::gil_scoped_release release;
+    const size_t pixels = static_cast<size_t>(source->width()) * source->height();
+    for (int i = 0; i < num_frames; ++i) {
+      const Image image = source->ReadImage(i);
+      std::copy(image.data(), image.data() + pixels, image_data + i * pixels);
+    }
+    if (source->has_events()) events = source->ReadAllEvents();
+  }
+  py::dict result;
+  result["path"] = path;
+  result["width"] = source->width();
+  result["height"] = source->height();
+  result["frames"] = images;
+  result["frame_times"] = Seconds(frame_t_ns);
+  result["exposures"] = exposures;
+  result["frame_paths"] = frame_paths;
+  result["events"] = EventsDict(std::move(events));
+  return result;
+}
+
+py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle events,
+                           const std::string& mode, int first, int last, int truth,
+                           py::handle exposures, py::handle options, const std::string& dtype) {
+  if (dtype != "float32" && dtype != "float64") {
+    throw InvalidArgumentError("dtype must be 'float32' or 'float64', not '" + dtype + "'");
+  }
+  ReconstructSettings settings = DefaultReconstructSettings();
+  ApplyReconstructOptions(options, &settings);
+  ResolveDenoise(&settings);
+  ReconstructRequest& request = settings.request;
+  request.data_label = kArraysLabel;
+  request.mode = ParseMode(mode);
+  request.first = first;
+  request.last = last;
+  request.truth = truth;
+
+  RecordingInput input;
+  SetFrames(frames, &input);
+  SetFrameTimes(frame_times, &input);
+  SetExposures(exposures, &input);
+  SetEvents(events, &input);
+  ReconstructResult result;
+  std::string summary;
+  {
+    py::gil_scoped_release release;
+    CheckRecordingArrays(input.recording, "frames", "events");
+    const ArraySource source(input.recording, kArraysLabel);
+    result = RunReconstruction(request, source);
+    summary = SummaryJson(request, result);
+  }
+  py::dict output;
+  output["times"] = Seconds(result.output.timestamps_ns());
+  output["frames"] = VideoArray(std::move(result.output), dtype);
+  output["summary"] = py::module_::import("json").attr("loads")(summary);
+  return output;
+}
+
+py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle options) {
+  SimulatorOptions simulator;
+  ApplySimulateOptions(options, &simulator);
+  std::string error;
+  if (!simulator.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
+  RecordingInput input;
+  SetFrames(frames, &input);
+  SetFrameTimes(frame_times, &input);
+  EventStream events;
+  {
+    py::gil_scoped_release release;
+    const RecordingArrays& recording = input.recording;
+    CheckRecordingArrays(recording, "frames", "events");
+    if (recording.num_frames < 2) {
+      throw InvalidArgumentError("simulate needs at least 2 frames (" +
+                                 std::to_string(recording.num_frames) + " found)");
+    }
+    const ArraySource source(recording, kArraysLabel);
+    Video video;
+    for (int i = 0; i < recording.num_frames; ++i) {
+      video.AppendFrame(source.ReadImage(i), recording.frame_t_ns[i]);
+    }
+    events = SimulateEvents(video, simulator);
+  }
+  return EventsDict(std::move(events));
+}
+
+}  // namespace
+}  // namespace evfs
+
+PYBIND11_MODULE(evfs, m) {
+  namespace py = pybind11;
+  m.doc() =
+      "evfs: event-driven video frame synthesis (Wang et al.) over NumPy arrays.\n\n"
+      "read(path) loads a recording; reconstruct(...) synthesises latent frames from frames and "
+      "events; simulate(...) makes events from frames. Options are the command line's flags "
+      "(reconstruct_defaults(), simulate_defaults()). User errors raise ValueError with the "
+      "command line's message, a failed solve RuntimeError.";
+  m.attr("__version__") = evfs::kVersion;
+
+  py::register_exception_translator([](std::exception_ptr error) {
+    try {
+      if (error) std::rethrow_exception(error);
+    } catch (const evfs::SolverError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const evfs::Error& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
+
+  m.def("read", &evfs::ReadArrays, py::arg("path"),
+        "Reads a recording: a data folder (Event Camera Dataset layout), an HDF5 file (.h5) or an "
+        "AEDAT 4 file (.aedat4). Returns a dict: 'frames' (frames x height x width float64 "
+        "intensities in [0, 1]), 'frame_times' (float64 seconds), 'exposures' (frames x 2 float64 "
+        "seconds, begin and end; NaN where unknown), 'frame_paths' (list of str), 'events' (dict "
+        "of 't' float64 seconds, 'x', 'y' uint16, 'p' int8 +1/-1), 'width', 'height', 'path'.");
+  m.def("reconstruct", &evfs::ReconstructArrays, py::arg("frames"), py::arg("frame_times"),
+        py::arg("events"), py::kw_only(), py::arg("mode") = "predict", py::arg("first") = 0,
+        py::arg("last") = -1, py::arg("truth") = -1, py::arg("exposures") = py::none(),
+        py::arg("options") = py::none(), py::arg("dtype") = "float32",
+        "Synthesises the latent frames of `mode` ('interpolate', 'predict' or 'deblur') from frame "
+        "`first` (and `last`; -1: first + 1) and the events, as `evfs reconstruct` does. frames: "
+        "frames x height x width float32 or float64 in [0, 1]; frame_times: float64 seconds, "
+        "increasing; events: as read() returns them (sorted by time); exposures: None or as "
+        "read() returns them; truth: a frame to score against (-1: none); options: a dict of the "
+        "command line's flags (reconstruct_defaults()). Returns a dict: 'frames' (latent frames, "
+        "frames x height x width of `dtype`: 'float32', or 'float64' for the solver's own "
+        "values), 'times' (float64 seconds) and 'summary' (summary.json as a dict).");
+  m.def("simulate", &evfs::SimulateArrays, py::arg("frames"), py::arg("frame_times"),
+        py::arg("options") = py::none(),
+        "Simulates the events of a sequence of frames (at least 2; frames x height x width "
+        "float32 or float64 in [0, 1], float64 seconds), as `evfs simulate` does. options: "
+        "simulate_defaults()'s keys. Returns the events as a dict like read()'s 'events'.");
+  m.def(
+      "reconstruct_defaults",
+      [] { return evfs::ReconstructOptionValues(evfs::DefaultReconstructSettings()); },
+      "Every key reconstruct's options accept, with its default (that of the command line).");
+  m.def(
+      "simulate_defaults", [] { return evfs::SimulateOptionValues(evfs::SimulatorOptions()); },
+      "Every key simulate's options accept, with its default (that of the command line).");
+}

@@ -1,0 +1,466 @@
+"""Tests of the Python module `evfs` (python/evfs_module.cc), run by ctest (python_pytest).
+
+The module is found through PYTHONPATH (build/python), the evfs command through EVFS_BINARY and
+the shared DAVIS snippets through EVFS_DATA_DIR; tests that need the snippets skip without them.
+Every comparison with the command line runs the command on the same input and compares its
+files with what the module returns.
+"""
+import glob
+import os
+import re
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import evfs
+
+SOURCE_DIR = os.environ.get(
+    "EVFS_SOURCE_DIR", os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..")))
+EVFS_BINARY = os.environ.get("EVFS_BINARY", os.path.join(SOURCE_DIR, "build", "examples", "evfs"))
+DATA_DIR = os.environ.get("EVFS_DATA_DIR", "")
+
+# evfs writes frames as 16-bit PNG: round(clamp(v, 0, 1) * 65535) (io/image_io.cc).
+PNG_MAX = 65535.0
+
+
+def shared_data(name):
+    path = os.path.join(DATA_DIR, name)
+    if not DATA_DIR or not os.path.exists(path):
+        pytest.skip(f"shared data {name} not found (EVFS_DATA_DIR={DATA_DIR!r})")
+    return path
+
+
+def run_cli(*args):
+    """Runs the evfs command; returns (exit status, stdout, stderr)."""
+    if not os.path.isfile(EVFS_BINARY):
+        pytest.skip(f"the evfs command is not built ({EVFS_BINARY})")
+    done = subprocess.run([EVFS_BINARY, *args], capture_output=True, text=True, timeout=600)
+    return done.returncode, done.stdout, done.stderr
+
+
+def cli_error(command, *args):
+    """The one-line message of a failing command, without its "evfs COMMAND: " prefix."""
+    status, _, stderr = run_cli(command, *args)
+    assert status == 2, stderr
+    line = stderr.strip().splitlines()[-1]
+    prefix = f"evfs {command}: "
+    assert line.startswith(prefix), line
+    return line[len(prefix):]
+
+
+def quantize_like_png(frames):
+    """The 16-bit values evfs writes for `frames` (std::lround of clamped v · 65535)."""
+    scaled = np.clip(frames, 0.0, 1.0) * PNG_MAX
+    whole = np.floor(scaled)
+    # scaled - whole is exact, so this is round-half-away-from-zero without a rounding error.
+    return (whole + (scaled - whole >= 0.5)).astype(np.uint16)
+
+
+def read_cli_reconstruction(folder):
+    """Frames (as the 16-bit values written) and times of an `evfs reconstruct` output."""
+    names = sorted(glob.glob(os.path.join(folder, "frames", "*.png")))
+    # The frames are read back through evfs.read, as a data folder whose images.txt lists them.
+    with open(os.path.join(folder, "images.txt"), "w") as images:
+        for i, name in enumerate(names):
+            images.write(f"{i} frames/{os.path.basename(name)}\n")
+    recording = evfs.read(folder)
+    frames = np.rint(recording["frames"] * PNG_MAX).astype(np.uint16)
+    times = []
+    with open(os.path.join(folder, "timestamps.txt")) as lines:
+        for line in lines:
+            times.append(float(line.split()[1]))
+    return frames, np.array(times)
+
+
+@pytest.fixture(scope="session")
+def demo(tmp_path_factory):
+    """`evfs demo`'s synthetic recordings: data (sharp frames) and data_blur (with exposures)."""
+    out = tmp_path_factory.mktemp("demo") / "demo"
+    status, _, stderr = run_cli("demo", f"--out={out}")
+    assert status == 0, stderr
+    return out
+
+
+def assert_same_recording(a, b, time_tolerance_s=0.0):
+    assert (a["width"], a["height"]) == (b["width"], b["height"])
+    np.testing.assert_array_equal(a["frames"], b["frames"])
+    np.testing.assert_array_equal(a["frame_times"], b["frame_times"])
+    for key in ("x", "y", "p"):
+        np.testing.assert_array_equal(a["events"][key], b["events"][key])
+    np.testing.assert_allclose(a["events"]["t"], b["events"]["t"], rtol=0, atol=time_tolerance_s)
+
+
+# ---------------------------------------------------------------------------------------------
+# read
+
+
+def test_read_text_folder(demo):
+    recording = evfs.read(str(demo / "data"))
+    frames, times, events = recording["frames"], recording["frame_times"], recording["events"]
+    assert frames.dtype == np.float64 and frames.ndim == 3 and frames.shape[0] == 5
+    assert frames.shape[1:] == (recording["height"], recording["width"])
+    assert frames.min() >= 0.0 and frames.max() <= 1.0
+    np.testing.assert_array_equal(times, [0.0, 0.01, 0.02, 0.03, 0.04])
+    assert np.isnan(recording["exposures"]).all()
+    assert recording["frame_paths"][0] == "images/frame_00000000.png"
+    assert events["t"].dtype == np.float64 and events["x"].dtype == np.uint16
+    assert events["y"].dtype == np.uint16 and events["p"].dtype == np.int8
+    # Against the text itself (events.txt: "t x y p", p 0/1).
+    text = np.loadtxt(demo / "data" / "events.txt")
+    np.testing.assert_array_equal(events["t"], text[:, 0])
+    np.testing.assert_array_equal(events["x"], text[:, 1])
+    np.testing.assert_array_equal(events["y"], text[:, 2])
+    np.testing.assert_array_equal(events["p"], np.where(text[:, 3] > 0, 1, -1))
+
+
+def test_read_exposures(demo):
+    recording = evfs.read(str(demo / "data_blur"))
+    lines = [line.split() for line in open(demo / "data_blur" / "exposures.txt")
+             if not line.startswith("#")]
+    assert len(lines) == recording["frames"].shape[0]
+    for row, (_, begin, end) in zip(recording["exposures"], lines):
+        np.testing.assert_array_equal(row, [float(begin), float(end)])
+
+
+def test_read_hdf5_matches_text(demo, tmp_path):
+    h5 = tmp_path / "demo.h5"
+    status, _, stderr = run_cli("convert", f"--data={demo / 'data'}", f"--out={h5}")
+    assert status == 0, stderr
+    assert_same_recording(evfs.read(str(h5)), evfs.read(str(demo / "data")))
+
+
+def test_read_shared_text_folder():
+    path = shared_data("slider_depth_70_71")
+    recording = evfs.read(path)
+    assert recording["frames"].shape == (2, 180, 240)
+    with open(os.path.join(path, "events.txt")) as lines:
+        first = lines.readline().split()
+        count = 1 + sum(1 for _ in lines)
+    events = recording["events"]
+    assert events["t"].shape == (count,)
+    assert events["t"][0] == float(first[0])
+    assert (events["x"][0], events["y"][0]) == (int(first[1]), int(first[2]))
+
+
+def test_read_shared_aedat4_against_independent_decoding():
+    path = os.path.join(shared_data("aedat4_dvxplorer_sample"), "sample.aedat4")
+    decoder = os.path.join(SOURCE_DIR, "tests", "io", "aedat4_reference_decode.py")
+    done = subprocess.run([sys.executable, decoder, path], capture_output=True, text=True)
+    if done.returncode == 3:
+        pytest.skip("the independent AEDAT 4 decoder needs python3-lz4 and python3-flatbuffers")
+    assert done.returncode == 0, done.stderr
+    reference = dict(line.split(" ", 1) for line in done.stdout.splitlines())
+    recording = evfs.read(path)
+    events = recording["events"]
+    assert f"{recording['width']} {recording['height']}" == reference["sensor"].strip()
+    assert events["t"].shape[0] == int(reference["events"])
+    assert int((events["p"] > 0).sum()) == int(reference["positive"])
+    # float64 seconds keep these microsecond clocks (~1.6e9 s) to well under 0.5 us.
+    t_us = np.rint(events["t"] * 1e6).astype(np.int64)
+    for key, i in (("first", 0), ("last", -1)):
+        described = f"{t_us[i]} {events['x'][i]} {events['y'][i]} {1 if events['p'][i] > 0 else 0}"
+        assert described == reference[key].strip()
+    assert recording["frames"].shape[0] == 0
+
+
+@pytest.mark.parametrize("name", ["fuzz_aedat4_misaligned_events.aedat4",
+                                  "fuzz_image_extent_wraps_int.h5"])
+def test_read_malformed_file_raises_the_cli_message(name):
+    path = os.path.join(SOURCE_DIR, "tests", "io", "data", name)
+    expected = cli_error("info", f"--data={path}")
+    with pytest.raises(ValueError) as raised:
+        evfs.read(path)
+    assert str(raised.value) == expected
+
+
+def test_read_missing_path_raises_the_cli_message(tmp_path):
+    path = str(tmp_path / "no_such_recording")
+    expected = cli_error("info", f"--data={path}")
+    with pytest.raises(ValueError, match=re.escape(expected)):
+        evfs.read(path)
+
+
+# ---------------------------------------------------------------------------------------------
+# reconstruct: identical to the command line
+
+
+def reconstruct_both(data, tmp_path, mode, first, last, cli_flags=(), options=None):
+    out = tmp_path / f"cli_{mode}"
+    status, _, stderr = run_cli("reconstruct", f"--data={data}", f"--mode={mode}",
+                                f"--first={first}", f"--last={last}", f"--out={out}", *cli_flags)
+    assert status == 0, stderr
+    cli_frames, cli_times = read_cli_reconstruction(str(out))
+    recording = evfs.read(str(data))
+    exposures = recording["exposures"] if mode == "deblur" else None
+    result = evfs.reconstruct(recording["frames"], recording["frame_times"], recording["events"],
+                              mode=mode, first=first, last=last, exposures=exposures,
+                              options=options, dtype="float64")
+    return cli_frames, cli_times, result
+
+
+@pytest.mark.parametrize("mode,first,last", [("predict", 0, 1), ("interpolate", 1, 3)])
+def test_reconstruct_identical_to_cli(demo, tmp_path, mode, first, last):
+    cli_frames, cli_times, result = reconstruct_both(demo / "data", tmp_path, mode, first, last)
+    assert result["frames"].dtype == np.float64
+    np.testing.assert_array_equal(result["times"], cli_times)
+    np.testing.assert_array_equal(quantize_like_png(result["frames"]), cli_frames)
+    assert result["summary"]["mode"] == mode
+    assert result["summary"]["latent_frames"] == cli_frames.shape[0]
+
+
+def test_reconstruct_deblur_with_options_identical_to_cli(demo, tmp_path):
+    cli_frames, cli_times, result = reconstruct_both(
+        demo / "data_blur", tmp_path, "deblur", 0, -1,
+        cli_flags=("--event_weight=0.4", "--spatial_tv=isotropic", "--denoise=none",
+                   "--max_iterations=8"),
+        options={"event_weight": 0.4, "spatial_tv": "isotropic", "denoise": "none",
+                 "max_iterations": 8})
+    assert result["summary"]["model"]["event_weight"] == 0.4
+    assert result["summary"]["model"]["spatial_tv"] == "isotropic"
+    assert result["summary"]["iterations"] <= 8
+    np.testing.assert_array_equal(result["times"], cli_times)
+    np.testing.assert_array_equal(quantize_like_png(result["frames"]), cli_frames)
+
+
+def test_reconstruct_shared_data_identical_to_cli(tmp_path):
+    data = shared_data("slider_depth_70_71")
+    cli_frames, cli_times, result = reconstruct_both(data, tmp_path, "predict", 0, 1)
+    np.testing.assert_array_equal(result["times"], cli_times)
+    np.testing.assert_array_equal(quantize_like_png(result["frames"]), cli_frames)
+
+
+def test_reconstruct_float32_is_the_float64_result_rounded(demo):
+    recording = evfs.read(str(demo / "data"))
+    args = (recording["frames"], recording["frame_times"], recording["events"])
+    options = {"denoise": "none", "threads": 1}
+    wide = evfs.reconstruct(*args, options=options, dtype="float64")
+    narrow = evfs.reconstruct(*args, options=options)
+    assert narrow["frames"].dtype == np.float32
+    np.testing.assert_array_equal(narrow["frames"], wide["frames"].astype(np.float32))
+    # float32 input frames give the same result when they hold the same values (these are
+    # 16-bit PNG values, but float32 rounds most of them: compare against the rounded input).
+    rounded = recording["frames"].astype(np.float32)
+    from_float32 = evfs.reconstruct(rounded, *args[1:], options=options, dtype="float64")
+    from_rounded = evfs.reconstruct(rounded.astype(np.float64), *args[1:], options=options,
+                                    dtype="float64")
+    np.testing.assert_array_equal(from_float32["frames"], from_rounded["frames"])
+
+
+def test_reconstruct_non_contiguous_frames(demo):
+    recording = evfs.read(str(demo / "data"))
+    frames = np.asfortranarray(recording["frames"])
+    assert not frames.flags["C_CONTIGUOUS"]
+    args = (recording["frame_times"], recording["events"])
+    options = {"solver": "copy"}
+    a = evfs.reconstruct(frames, *args, options=options, dtype="float64")
+    b = evfs.reconstruct(recording["frames"], *args, options=options, dtype="float64")
+    np.testing.assert_array_equal(a["frames"], b["frames"])
+
+
+def test_reconstruct_truth_scores(demo):
+    recording = evfs.read(str(demo / "data"))
+    result = evfs.reconstruct(recording["frames"], recording["frame_times"], recording["events"],
+                              mode="predict", first=0, last=1, truth=1,
+                              options={"denoise": "none"})
+    truth = result["summary"]["truth"]
+    assert truth["index"] == 1 and truth["psnr"] > truth["baseline_psnr"]
+
+
+# ---------------------------------------------------------------------------------------------
+# options: the command line's flags and defaults
+
+
+def cli_flag_defaults(command):
+    """{flag: (type, default text)} from `evfs COMMAND --help`."""
+    status, stdout, stderr = run_cli(command, "--help")
+    assert status == 0, stderr
+    flags = {}
+    for name, kind, default in re.findall(r"^  --(\w+) \((\w+), default: (.*)\)$", stdout,
+                                          re.MULTILINE):
+        flags[name] = (kind, default)
+    return flags
+
+
+def same_default(kind, text, value):
+    if kind == "bool":
+        return value is (text == "true")
+    if kind == "string":
+        text = text.strip('"')
+        return value == text if isinstance(value, str) else text == ",".join(map(str, value))
+    return float(text) == float(value)
+
+
+# Flags of `evfs reconstruct` that are arguments of evfs.reconstruct, or that have no meaning
+# without files and a terminal.
+RECONSTRUCT_ARGUMENTS = {"data", "mode", "first", "last", "truth", "out", "overwrite",
+                         "progress", "progress_interval_s"}
+SIMULATE_ARGUMENTS = {"frames", "out", "overwrite", "progress_interval_s"}
+
+
+@pytest.mark.parametrize("command,defaults,arguments", [
+    ("reconstruct", evfs.reconstruct_defaults, RECONSTRUCT_ARGUMENTS),
+    ("simulate", evfs.simulate_defaults, SIMULATE_ARGUMENTS),
+])
+def test_options_are_the_cli_flags_with_their_defaults(command, defaults, arguments):
+    flags = cli_flag_defaults(command)
+    values = defaults()
+    assert set(values) == set(flags) - arguments
+    for key, value in values.items():
+        kind, text = flags[key]
+        assert same_default(kind, text, value), f"{key}: CLI {text}, Python {value!r}"
+
+
+# ---------------------------------------------------------------------------------------------
+# bad inputs: clear errors, the command line's messages where it has the same check
+
+
+@pytest.fixture(scope="module")
+def small(demo):
+    return evfs.read(str(demo / "data"))
+
+
+def reconstruct(small, **changes):
+    args = {"frames": small["frames"], "frame_times": small["frame_times"],
+            "events": dict(small["events"])}
+    args.update(changes)
+    return evfs.reconstruct(args.pop("frames"), args.pop("frame_times"), args.pop("events"),
+                            **args)
+
+
+def test_bad_frames(small):
+    with pytest.raises(ValueError, match="frames must be a 3-D float32 or float64 array"):
+        reconstruct(small, frames=small["frames"].astype(np.uint16))
+    with pytest.raises(ValueError, match=r"frames must be a 3-D float64 array, not 2-D"):
+        reconstruct(small, frames=small["frames"][0])
+    with pytest.raises(ValueError, match="frames must be a NumPy array"):
+        reconstruct(small, frames=small["frames"].tolist())
+    bright = small["frames"].copy()
+    bright[1, 2, 3] = 1.5
+    with pytest.raises(ValueError, match=r"intensities in \[0, 1\]: \[1, 2, 3\] is 1.5"):
+        reconstruct(small, frames=bright)
+
+
+def test_bad_frame_times(small):
+    with pytest.raises(ValueError, match="frame_times must increase strictly"):
+        reconstruct(small, frame_times=small["frame_times"][::-1].copy())
+    with pytest.raises(ValueError, match="one time per frame"):
+        reconstruct(small, frame_times=small["frame_times"][:3])
+    with pytest.raises(ValueError, match=r"frame_times must be a 1-D float64 array, not int64"):
+        reconstruct(small, frame_times=np.arange(5))
+
+
+def test_bad_events(small):
+    events = dict(small["events"])
+    unsorted = dict(events, t=events["t"][::-1].copy())
+    with pytest.raises(ValueError, match=r"events\['t'\] must be sorted"):
+        reconstruct(small, events=unsorted)
+    with pytest.raises(ValueError, match=r"events\['x'\] must be a 1-D uint16 array, not int64"):
+        reconstruct(small, events=dict(events, x=events["x"].astype(np.int64)))
+    outside = events["x"].copy()
+    outside[7] = small["width"]
+    with pytest.raises(ValueError, match=r"event 7 at x=120, .* lies outside the 120x96 frames"):
+        reconstruct(small, events=dict(events, x=outside))
+    zero = events["p"].copy()
+    zero[4] = 0
+    with pytest.raises(ValueError, match=r"events\['p'\]\[4\] is 0"):
+        reconstruct(small, events=dict(events, p=zero))
+    with pytest.raises(ValueError, match="must have the same length"):
+        reconstruct(small, events=dict(events, y=events["y"][1:]))
+    with pytest.raises(ValueError, match="events has no 'p'"):
+        reconstruct(small, events={k: events[k] for k in "txy"})
+
+
+def test_bad_arguments_raise_the_cli_messages(small, demo, tmp_path):
+    data = str(demo / "data")
+    out = f"--out={tmp_path / 'never_written'}"
+    expected = cli_error("reconstruct", f"--data={data}", "--mode=predict", "--first=7", out)
+    with pytest.raises(ValueError) as raised:
+        reconstruct(small, first=7)
+    assert str(raised.value) == expected.replace(data, "the frames array")
+    expected = cli_error("reconstruct", f"--data={data}", "--mode=sideways", "--first=0", out)
+    with pytest.raises(ValueError) as raised:
+        reconstruct(small, mode="sideways")
+    assert str(raised.value) == expected
+    for flag, value in (("solver", "newton"), ("spatial_tv", "diagonal"),
+                        ("linear_solver", "MAGIC"), ("frame_weight", "-1")):
+        expected = cli_error("reconstruct", f"--data={data}", "--mode=predict", "--first=0",
+                             f"--{flag}={value}", out)
+        option = float(value) if flag == "frame_weight" else value
+        with pytest.raises(ValueError) as raised:
+            reconstruct(small, options={flag: option})
+        assert str(raised.value) == expected
+
+
+def test_bad_options(small):
+    with pytest.raises(ValueError, match="unknown option 'iterations': expected one of"):
+        reconstruct(small, options={"iterations": 3})
+    with pytest.raises(ValueError, match="option 'max_iterations' must be an integer, not float"):
+        reconstruct(small, options={"max_iterations": 2.5})
+    with pytest.raises(ValueError, match="option 'bounds' must be True or False, not int"):
+        reconstruct(small, options={"bounds": 1})
+    with pytest.raises(ValueError, match="option 'event_weight' must be a number, not str"):
+        reconstruct(small, options={"event_weight": "0.3"})
+    with pytest.raises(ValueError, match="dtype must be 'float32' or 'float64'"):
+        reconstruct(small, dtype="float16")
+
+
+# ---------------------------------------------------------------------------------------------
+# simulate
+
+
+def test_simulate_identical_to_cli(demo, tmp_path):
+    frames_dir = demo / "data"
+    out = tmp_path / "simulated"
+    status, _, stderr = run_cli("simulate", f"--frames={frames_dir}", f"--out={out}",
+                                "--threshold_pos=0.15", "--seed=7")
+    assert status == 0, stderr
+    expected = evfs.read(str(out))["events"]
+    recording = evfs.read(str(frames_dir))
+    events = evfs.simulate(recording["frames"], recording["frame_times"],
+                           {"threshold_pos": 0.15, "seed": 7})
+    assert events["t"].shape[0] > 1000
+    for key in "txyp":
+        np.testing.assert_array_equal(events[key], expected[key])
+
+
+def test_simulate_bad_input(small):
+    with pytest.raises(ValueError, match=r"simulate needs at least 2 frames \(1 found\)"):
+        evfs.simulate(small["frames"][:1], small["frame_times"][:1])
+    with pytest.raises(ValueError, match="simulator: "):
+        evfs.simulate(small["frames"], small["frame_times"], {"threshold_pos": -1.0})
+
+
+# ---------------------------------------------------------------------------------------------
+# the GIL is released while evfs works
+
+
+def test_gil_released_during_solve(small):
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+
+    # Enough work to take a while on any machine: Adam's full schedule on one thread.
+    options = {"solver": "adam", "adam_iterations": 1000, "threads": 1, "denoise": "none"}
+    counter = threading.Thread(target=count)
+    counter.start()
+    try:
+        begin = time.perf_counter()
+        reconstruct(small, options=options)
+        end = time.perf_counter()
+    finally:
+        stop.set()
+        counter.join()
+    during = np.array([t for t in ticks if begin <= t <= end])
+    duration = end - begin
+    assert duration > 0.2, "the solve was too short to tell"
+    # Holding the GIL, the solve would stop the counter for its whole duration; released, the
+    # counter runs on (gaps only where the OS or the interpreter's switch interval pauses it).
+    gaps = np.diff(np.concatenate([[begin], during, [end]]))
+    assert gaps.max() < 0.5 * duration, f"longest pause {gaps.max():.3f} s of {duration:.3f} s"

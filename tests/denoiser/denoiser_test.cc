@@ -1,0 +1,318 @@
+#include "denoiser/denoiser.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <string>
+
+#include "core/error.h"
+#include "denoiser/sha256.h"
+#include "tests/test_data.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+
+// OpenCV runs the network in float32: on intensities in [0, 1] through two 3×3 layers with
+// weights of magnitude <= 1, the rounding error stays far below this.
+constexpr double kFloatTolerance = 1e-5;
+// A tile and the whole frame sum the same products, possibly in another order (vectorised
+// loops over rows of another length): float32 rounding of values of order 1.
+constexpr double kTileTolerance = 1e-6;
+// Issue 17's bound for the C++ inference against the trainer's PyTorch output: the two run the
+// same float32 network with other summation orders.
+constexpr double kTorchTolerance = 1e-4;
+constexpr double kRelativeTorchTolerance = 1e-3;
+
+std::string DataPath(const std::string& name) {
+  return (fs::path(EVFS_TEST_SOURCE_DIR) / "data" / name).string();
+}
+
+DenoiserOptions TwoConvOptions(int num_threads = 1) {
+  DenoiserOptions options;
+  options.weights_path = DataPath("two_conv.onnx");
+  options.num_threads = num_threads;
+  return options;
+}
+
+// A video of uniform random intensities in [0, 1], seeded.
+Video RandomVideo(int height, int width, int num_frames, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  Video video(height, width, num_frames);
+  for (int64_t i = 0; i < video.pixels_per_frame() * num_frames; ++i) {
+    video.data()[i] = uniform(random);
+  }
+  for (int t = 0; t < num_frames; ++t) video.set_timestamp_ns(t, 1000 * t);
+  return video;
+}
+
+// The network of data/make_test_networks.py, written out independently in double precision:
+//   hidden_c = relu(b1_c + Σ_{dy,dx} W1[c](dy,dx) · H(y+dy, x+dx)),  c = 0, 1
+//   R        = b2 + Σ_c Σ_{dy,dx} W2[c](dy,dx) · hidden_c(y+dy, x+dx)
+// with zeros outside the image at each layer (ONNX Conv pads 1).
+using Kernel = std::array<std::array<double, 3>, 3>;
+const std::array<Kernel, 2> kFirstKernels = {
+    Kernel{{{0, 1.0 / 8, 0}, {1.0 / 8, -4.0 / 8, 1.0 / 8}, {0, 1.0 / 8, 0}}},
+    Kernel{{{1.0 / 8, 2.0 / 8, 1.0 / 8}, {0, 0, 0}, {-1.0 / 8, -2.0 / 8, -1.0 / 8}}}};
+const std::array<double, 2> kFirstBias = {0.125, -0.25};
+const std::array<Kernel, 2> kSecondKernels = {
+    Kernel{{{0, 0, 0}, {0, 4.0 / 8, 0}, {0, 0, 0}}},
+    Kernel{{{1.0 / 8, 0, -1.0 / 8}, {2.0 / 8, 0, -2.0 / 8}, {1.0 / 8, 0, -1.0 / 8}}}};
+const double kSecondBias = -0.0625;
+
+Image Correlate(const Image& image, const Kernel& kernel) {
+  Image result = Image::Zero(image.rows(), image.cols());
+  for (int y = 0; y < image.rows(); ++y) {
+    for (int x = 0; x < image.cols(); ++x) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int yy = y + dy, xx = x + dx;
+          if (yy < 0 || xx < 0 || yy >= image.rows() || xx >= image.cols()) continue;
+          result(y, x) += kernel[dy + 1][dx + 1] * image(yy, xx);
+        }
+      }
+    }
+  }
+  return result;
+}
+
+Image HandResidual(const Image& frame) {
+  Image residual = Image::Constant(frame.rows(), frame.cols(), kSecondBias);
+  for (int c = 0; c < 2; ++c) {
+    const Image hidden = (Correlate(frame, kFirstKernels[c]) + kFirstBias[c]).max(0.0);
+    residual += Correlate(hidden, kSecondKernels[c]);
+  }
+  return residual;
+}
+
+TEST(DenoiserOptionsTest, Validity) {
+  std::string error;
+  DenoiserOptions options = TwoConvOptions();
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  options.weights_path.clear();
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("weights"), std::string::npos) << error;
+  options = TwoConvOptions();
+  options.tile_size_px = 2;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("tile_size_px"), std::string::npos) << error;
+  options = TwoConvOptions();
+  options.num_threads = -1;
+  EXPECT_FALSE(options.IsValid(&error));
+  options = TwoConvOptions();
+  options.margin_px = -2;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_THROW(Denoiser{options}, InvalidArgumentError);
+}
+
+TEST(DenoiserTest, MatchesTheHandComputedNetwork) {
+  const Denoiser denoiser(TwoConvOptions());
+  EXPECT_EQ(denoiser.receptive_radius_px(), 2);
+  EXPECT_EQ(denoiser.margin_px(), 2);
+  const Video video = RandomVideo(37, 53, 3, 7);
+  DenoiseStats stats;
+  const Video denoised = denoiser.Apply(video, {}, &stats);
+  ASSERT_EQ(denoised.num_frames(), 3);
+  EXPECT_EQ(denoised.timestamps_ns(), video.timestamps_ns());
+  EXPECT_EQ(stats.frames, 3);
+  EXPECT_EQ(stats.pixels_changed, 3 * 37 * 53);
+  for (int t = 0; t < 3; ++t) {
+    const Image expected = Image(video.frame(t)) - HandResidual(video.frame(t));
+    const double error = (Image(denoised.frame(t)) - expected).abs().maxCoeff();
+    EXPECT_LT(error, kFloatTolerance) << "frame " << t;
+  }
+}
+
+// A frame cut into tiles (context = receptive radius) gives the whole frame's values at the
+// selected pixels and leaves every other pixel bit-identical.
+TEST(DenoiserTest, TilesMatchTheWholeFrameAndSkippedPixelsAreUntouched) {
+  const Video video = RandomVideo(70, 90, 2, 11);
+  const Video whole = Denoiser(TwoConvOptions()).Apply(video);
+
+  DenoiserOptions options = TwoConvOptions();
+  options.tile_size_px = 8;
+  const Denoiser tiled(options);
+  DenoiseRegion region;
+  region.pixels.assign(video.pixels_per_frame(), 0);
+  // Two blobs, one touching the image border, and a lone pixel on a tile's corner.
+  for (int y = 0; y < 12; ++y) {
+    for (int x = 70; x < 90; ++x) region.pixels[y * 90 + x] = 1;
+  }
+  for (int y = 30; y < 45; ++y) {
+    for (int x = 20; x < 33; ++x) region.pixels[y * 90 + x] = 1;
+  }
+  region.pixels[56 * 90 + 47] = 1;
+  DenoiseStats stats;
+  const Video denoised = tiled.Apply(video, region, &stats);
+  EXPECT_GT(stats.tiles, 2);
+  EXPECT_LT(stats.network_pixels, 2 * video.pixels_per_frame());
+  int64_t changed = 0;
+  for (int t = 0; t < 2; ++t) {
+    for (int64_t p = 0; p < video.pixels_per_frame(); ++p) {
+      const double value = denoised.frame_data(t)[p];
+      if (region.pixels[p]) {
+        EXPECT_NEAR(value, whole.frame_data(t)[p], kTileTolerance) << "t " << t << " p " << p;
+        changed += value != video.frame_data(t)[p];
+      } else {
+        ASSERT_EQ(std::memcmp(&value, &video.frame_data(t)[p], sizeof(double)), 0)
+            << "skipped pixel " << p << " of frame " << t << " changed";
+      }
+    }
+  }
+  EXPECT_EQ(stats.pixels_changed, 2 * (12 * 20 + 15 * 13 + 1));
+  EXPECT_GT(changed, stats.pixels_changed / 2);
+}
+
+TEST(DenoiserTest, UnselectedFramesAreBitIdentical) {
+  const Video video = RandomVideo(20, 30, 4, 3);
+  DenoiseRegion region;
+  region.frames = {0, 1, 0, 1};
+  DenoiseStats stats;
+  const Video denoised = Denoiser(TwoConvOptions()).Apply(video, region, &stats);
+  EXPECT_EQ(stats.frames, 2);
+  for (const int t : {0, 2}) {
+    EXPECT_EQ(std::memcmp(denoised.frame_data(t), video.frame_data(t),
+                          sizeof(double) * video.pixels_per_frame()),
+              0);
+  }
+  for (const int t : {1, 3}) {
+    EXPECT_GT((Image(denoised.frame(t)) - Image(video.frame(t))).abs().maxCoeff(), 0.01);
+  }
+  region.frames.clear();
+  region.pixels.assign(video.pixels_per_frame(), 0);
+  const Video untouched = Denoiser(TwoConvOptions()).Apply(video, region, &stats);
+  EXPECT_EQ(stats.tiles, 0);
+  EXPECT_EQ(std::memcmp(untouched.data(), video.data(),
+                        sizeof(double) * video.pixels_per_frame() * video.num_frames()),
+            0);
+}
+
+TEST(DenoiserTest, ThreadsGiveTheSameResult) {
+  DenoiserOptions options = TwoConvOptions(1);
+  options.tile_size_px = 16;
+  const Video video = RandomVideo(64, 80, 5, 5);
+  const Video one = Denoiser(options).Apply(video);
+  options.num_threads = 3;
+  const Video three = Denoiser(options).Apply(video);
+  EXPECT_EQ(std::memcmp(one.data(), three.data(),
+                        sizeof(double) * video.pixels_per_frame() * video.num_frames()),
+            0);
+}
+
+TEST(DenoiserTest, RegionOfTheWrongSizeIsAnError) {
+  const Denoiser denoiser(TwoConvOptions());
+  const Video video = RandomVideo(10, 12, 2, 1);
+  DenoiseRegion region;
+  region.pixels.assign(10 * 11, 1);
+  EXPECT_THROW(denoiser.Apply(video, region), InvalidArgumentError);
+  region.pixels.clear();
+  region.frames.assign(3, 1);
+  EXPECT_THROW(denoiser.Apply(video, region), InvalidArgumentError);
+}
+
+TEST(DenoiserTest, RecordsTheWeightsSha256) {
+  const std::string path = DataPath("two_conv.onnx");
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const Denoiser denoiser(TwoConvOptions());
+  EXPECT_EQ(denoiser.weights_path(), path);
+  EXPECT_EQ(denoiser.weights_sha256(), Sha256Hex(bytes));
+}
+
+// The shipped weights against the trainer: tools/train_denoiser/train.py writes a small input
+// and PyTorch's residual R for it (PFM, float32) together with models/evfs_denoiser.onnx.
+TEST(DenoiserTest, ShippedWeightsMatchTheTrainersPyTorchOutput) {
+  const fs::path source = fs::path(EVFS_TEST_SOURCE_DIR);
+  const std::string weights = (source / ".." / ".." / "models" / "evfs_denoiser.onnx").string();
+  const std::string input_path = DataPath("reference_input.pfm");
+  const std::string output_path = DataPath("reference_output.pfm");
+  if (!fs::exists(weights) || !fs::exists(input_path) || !fs::exists(output_path)) {
+    GTEST_SKIP() << "models/evfs_denoiser.onnx or tests/denoiser/data/reference_*.pfm missing "
+                    "(make train-denoiser writes them)";
+  }
+  const cv::Mat input = cv::imread(input_path, cv::IMREAD_UNCHANGED);
+  const cv::Mat expected = cv::imread(output_path, cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(input.type(), CV_32FC1);
+  ASSERT_EQ(expected.type(), CV_32FC1);
+  ASSERT_EQ(input.size(), expected.size());
+  Video video(input.rows, input.cols, 1);
+  for (int y = 0; y < input.rows; ++y) {
+    for (int x = 0; x < input.cols; ++x) video.at(0, y, x) = input.at<float>(y, x);
+  }
+  DenoiserOptions options;
+  options.weights_path = weights;
+  options.num_threads = 1;
+  const Video denoised = Denoiser(options).Apply(video);
+  double max_error = 0.0, max_residual = 0.0;
+  for (int y = 0; y < input.rows; ++y) {
+    for (int x = 0; x < input.cols; ++x) {
+      const double residual = video.at(0, y, x) - denoised.at(0, y, x);
+      max_error = std::max(max_error, std::abs(residual - expected.at<float>(y, x)));
+      max_residual = std::max(max_residual, std::abs(double{expected.at<float>(y, x)}));
+    }
+  }
+  // Weights whose residual is tiny everywhere would pass 1e-4 whatever C++ computed: the bound
+  // is also held relative to the largest residual (float32 keeps ~1e-6 of it).
+  ASSERT_GT(max_residual, 0.0);
+  EXPECT_LT(max_error, std::min(kTorchTolerance, kRelativeTorchTolerance * max_residual))
+      << "largest |R| " << max_residual;
+}
+
+// Loading `path` fails with an InputError naming it, in one line.
+void ExpectBadWeights(const std::string& path, const std::string& expected_words) {
+  DenoiserOptions options = TwoConvOptions();
+  options.weights_path = path;
+  try {
+    Denoiser denoiser(options);
+    ADD_FAILURE() << path << " loaded";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(error.file(), path);
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find(expected_words), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+void WriteFile(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+TEST(DenoiserTest, BadWeightsFilesAreUserErrors) {
+  const std::string dir = test::ScratchDir("bad_weights");
+  ExpectBadWeights(dir + "/missing.onnx", "not found");
+  ExpectBadWeights(dir, "not a folder");
+  WriteFile(dir + "/empty.onnx", "");
+  ExpectBadWeights(dir + "/empty.onnx", "empty");
+  WriteFile(dir + "/text.onnx", "this is not a network\n");
+  ExpectBadWeights(dir + "/text.onnx", "not an ONNX network");
+  std::ifstream in(DataPath("two_conv.onnx"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  WriteFile(dir + "/truncated.onnx", bytes.substr(0, bytes.size() / 2));
+  ExpectBadWeights(dir + "/truncated.onnx", "not an ONNX network");
+  ExpectBadWeights(DataPath("two_channels.onnx"), "1x1xHxW");
+  ExpectBadWeights(DataPath("three_inputs.onnx"), "1x1xHxW");
+}
+
+TEST(DenoiserTest, UnreadableWeightsAreUserErrors) {
+  if (geteuid() == 0) GTEST_SKIP() << "running as root: file permissions do not stop reading";
+  const std::string dir = test::ScratchDir("unreadable_weights");
+  const std::string path = dir + "/locked.onnx";
+  fs::copy_file(DataPath("two_conv.onnx"), path);
+  fs::permissions(path, fs::perms::none);
+  ExpectBadWeights(path, "cannot be read");
+}
+
+}  // namespace
+}  // namespace evfs

@@ -1,0 +1,297 @@
+// `evfs video` end to end on small synthetic recordings: the frames, their uniform timestamps,
+// observed frames unchanged, --jobs not changing the output, an interrupted run resumed into
+// the same output, and bad flags as one-line user errors. Each test works in a scratch folder.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/video.h"
+#include "events/scene_synthesizer.h"
+#include "events/simulator.h"
+#include "io/data_source.h"
+#include "io/image_io.h"
+#include "io/text_folder.h"
+#include "tests/examples/cli_test_util.h"
+#include "tests/io/io_test_util.h"
+#include "tests/test_data.h"
+
+namespace evfs {
+namespace {
+
+namespace fs = std::filesystem;
+
+using test::CommandResult;
+using test::ReadFile;
+using test::RunEvfs;
+
+// A recording of `num_frames` frames `frame_step_ms` apart, rendered at 1 kHz, with events
+// simulated from the rendering.
+std::string WriteRecording(const fs::path& root, int num_frames, int frame_step_ms, int width,
+                           int height) {
+  SceneOptions scene;
+  scene.width = width;
+  scene.height = height;
+  scene.duration_s = (num_frames - 1) * frame_step_ms / 1000.0;
+  scene.num_shapes = 2;
+  scene.min_shape_size_px = 5.0;
+  scene.max_shape_size_px = 10.0;
+  const Video rendered = SceneSynthesizer(scene).RenderAtRate(1000.0);
+  const EventStream events = SimulateEvents(rendered, SimulatorOptions());
+  std::vector<FrameInfo> frames;
+  std::vector<Image> images;
+  for (int t = 0; t < rendered.num_frames(); t += frame_step_ms) {
+    FrameInfo info;
+    info.t_ns = rendered.timestamp_ns(t);
+    info.path = "images/frame_" + std::to_string(t) + ".png";
+    frames.push_back(info);
+    images.push_back(rendered.frame(t));
+  }
+  const std::string folder = (root / "data").string();
+  WriteDataFolder(folder, events, frames, images);
+  return folder;
+}
+
+// frames/NNNNNN.png
+std::string FrameFileName(int n) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06d.png", n);
+  return name;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::stringstream stream(text);
+  for (std::string line; std::getline(stream, line);) lines.push_back(line);
+  return lines;
+}
+
+// frames/ and timestamps.txt of two outputs hold the same bytes.
+void ExpectSameFrames(const fs::path& a, const fs::path& b) {
+  EXPECT_EQ(ReadFile(a / "timestamps.txt"), ReadFile(b / "timestamps.txt"));
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(a / "frames")) {
+    const fs::path other = b / "frames" / entry.path().filename();
+    ASSERT_TRUE(fs::exists(other)) << other;
+    EXPECT_EQ(ReadFile(entry.path()), ReadFile(other)) << entry.path().filename();
+    ++count;
+  }
+  EXPECT_EQ(count, std::distance(fs::directory_iterator(b / "frames"), fs::directory_iterator()));
+  EXPECT_GT(count, 0);
+}
+
+TEST(EvfsVideo, AWholeRecordingBecomesUniformFramesWithTheObservedOnesUnchanged) {
+  const fs::path root = test::ScratchDir("video_end_to_end");
+  const std::string data = WriteRecording(root, 5, 5, 40, 32);
+  const fs::path out = root / "out";
+  const CommandResult result =
+      RunEvfs("video --data=" + data + " --out=" + out.string() + " --fps=1000 --jobs=1");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+
+  // Frames 5 ms apart over 20 ms at 1000 fps: 21 output frames, 1 ms apart.
+  const std::vector<std::string> stamps = Lines(ReadFile(out / "timestamps.txt"));
+  ASSERT_EQ(stamps.size(), 21u);
+  const auto source = DataSource::Open(data);
+  const double t0_s = source->frames()[0].t_ns * 1e-9;
+  for (size_t n = 0; n < stamps.size(); ++n) {
+    int index = -1;
+    double t_s = 0.0;
+    std::istringstream(stamps[n]) >> index >> t_s;
+    EXPECT_EQ(index, static_cast<int>(n));
+    // Timestamps are printed with 9 decimals: exact to the nanosecond.
+    EXPECT_NEAR(t_s, t0_s + n * 1e-3, 1e-9) << stamps[n];
+  }
+  ASSERT_EQ(std::distance(fs::directory_iterator(out / "frames"), fs::directory_iterator()), 21);
+
+  // Output frame 5k lies on observed frame k: its pixels, exactly (8-bit frames are exact in
+  // the 16-bit output).
+  for (int k = 0; k < 5; ++k) {
+    const Image observed = source->ReadImage(k);
+    const Image written = ReadGreyImage((out / "frames" / FrameFileName(5 * k)).string());
+    EXPECT_EQ((observed - written).abs().maxCoeff(), 0.0) << "observed frame " << k;
+  }
+  // A frame between two observed ones is a reconstruction, not a copy.
+  const Image between = ReadGreyImage((out / "frames" / FrameFileName(2)).string());
+  EXPECT_GT((between - source->ReadImage(0)).abs().maxCoeff(), 0.0);
+
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["command"], "video");
+  EXPECT_EQ(summary["output_frames"], 21);
+  ASSERT_GE(summary["windows"].size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    const nlohmann::json& window = summary["windows"][i];
+    EXPECT_EQ(window["mode"], "interpolate");
+    EXPECT_EQ(window["frames"][0]["index"], i);
+    EXPECT_EQ(window["frames"][1]["index"], i + 1);
+    EXPECT_GT(window["events"].get<int64_t>(), 0);
+    EXPECT_GE(window["latent_frames"].get<int>(), 2);
+  }
+  EXPECT_TRUE(summary["video"]["codec"] == "avc1" || summary["video"]["codec"] == "mp4v");
+  EXPECT_GT(fs::file_size(out / "video.mp4"), 0u);
+  // Nothing left beside the output: no staging folder, no work folder.
+  test::ExpectNoStagingLeft(out);
+}
+
+TEST(EvfsVideo, WindowsWithoutEventsAreAnsweredWithoutASolve) {
+  const fs::path root = test::ScratchDir("video_no_events");
+  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  // The same frames with an empty events.txt.
+  test::WriteFile((fs::path(data) / "events.txt").string(), "");
+  const fs::path out = root / "out";
+  const CommandResult result =
+      RunEvfs("video --data=" + data + " --out=" + out.string() + " --fps=1000 --denoise=none");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  ASSERT_EQ(summary["windows"].size(), 2u);
+  for (const nlohmann::json& window : summary["windows"]) {
+    EXPECT_EQ(window["events"], 0);
+    EXPECT_EQ(window["solved"], false);
+    EXPECT_EQ(window["iterations"], 0);
+  }
+}
+
+TEST(EvfsVideo, OneJobAndTwoJobsWriteTheSameFrames) {
+  const fs::path root = test::ScratchDir("video_jobs");
+  const std::string data = WriteRecording(root, 7, 5, 40, 32);
+  const std::string common = "video --data=" + data + " --fps=700 --preview";
+  const CommandResult one = RunEvfs(common + " --jobs=1 --out=" + (root / "one").string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  const CommandResult two = RunEvfs(common + " --jobs=2 --out=" + (root / "two").string());
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  ExpectSameFrames(root / "one", root / "two");
+  EXPECT_GT(fs::file_size(root / "two" / "preview.mp4"), 0u);
+}
+
+// Starts evfs with `arguments` in the background, its output in files in `folder`.
+pid_t StartEvfs(const std::vector<std::string>& arguments, const fs::path& folder) {
+  const pid_t pid = fork();
+  if (pid != 0) return pid;
+  const std::string out = (folder / "stdout.txt").string();
+  const std::string err = (folder / "stderr.txt").string();
+  if (!freopen(out.c_str(), "w", stdout) || !freopen(err.c_str(), "w", stderr)) _exit(120);
+  std::vector<char*> argv = {const_cast<char*>(EVFS_BINARY)};
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  execv(EVFS_BINARY, argv.data());
+  _exit(121);
+}
+
+TEST(EvfsVideo, AnInterruptedRunResumesIntoTheSameOutput) {
+  const fs::path root = test::ScratchDir("video_resume");
+  // 30 windows, solved one at a time: the run is stopped after its first windows.
+  const std::string data = WriteRecording(root, 31, 4, 64, 48);
+  const std::vector<std::string> arguments = {"video", "--data=" + data, "--fps=500", "--jobs=1",
+                                              "--threads=1"};
+  std::vector<std::string> reference = arguments;
+  reference.push_back("--out=" + (root / "reference").string());
+  const pid_t reference_pid = StartEvfs(reference, root);
+  int status = 0;
+  ASSERT_EQ(waitpid(reference_pid, &status, 0), reference_pid);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << ReadFile(root / "stderr.txt");
+
+  const fs::path out = root / "out";
+  std::vector<std::string> interrupted = arguments;
+  interrupted.push_back("--out=" + out.string());
+  const pid_t pid = StartEvfs(interrupted, root);
+  ASSERT_GT(pid, 0);
+  const fs::path work = root / ".out.evfs-video-work";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(work / "windows" / "000002.json") &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(fs::exists(work / "windows" / "000002.json")) << "no window finished";
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before the signal: make it longer";
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(work / ".evfs-video-work"));
+
+  const std::string resume_flags = " --fps=500 --jobs=1 --threads=1 --resume";
+  const CommandResult resumed =
+      RunEvfs("video --data=" + data + " --out=" + out.string() + resume_flags);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_GE(summary["run"]["windows_resumed"].get<int>(), 3);
+  EXPECT_LT(summary["run"]["windows_resumed"].get<int>(), 30);
+  ExpectSameFrames(root / "reference", out);
+  EXPECT_FALSE(fs::exists(work));
+}
+
+TEST(EvfsVideo, ResumeWithOtherSettingsIsRefused) {
+  const fs::path root = test::ScratchDir("video_resume_settings");
+  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  // An interrupted run's work folder, as evfs leaves it.
+  const fs::path work = root / ".out.evfs-video-work";
+  fs::create_directories(work / "windows");
+  fs::create_directories(work / "frames");
+  test::WriteFile((work / ".evfs-video-work").string(),
+                  "evfs video work folder\nsettings of another run");
+  const fs::path out = root / "out";
+  const CommandResult result =
+      RunEvfs("video --data=" + data + " --out=" + out.string() + " --resume");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
+  EXPECT_NE(result.errors.find("other settings"), std::string::npos) << result.errors;
+  EXPECT_FALSE(fs::exists(out));
+  // Kept: the run it belongs to can still be resumed with its own settings.
+  EXPECT_TRUE(fs::exists(work / ".evfs-video-work"));
+}
+
+TEST(EvfsVideo, AWorkFolderPathEvfsDidNotMarkIsNeverTouched) {
+  const fs::path root = test::ScratchDir("video_foreign_work");
+  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  const fs::path work = root / ".out.evfs-video-work";
+  fs::create_directories(work);
+  test::WriteFile((work / "notes.txt").string(), "precious");
+  const fs::path out = root / "out";
+  const CommandResult result = RunEvfs("video --data=" + data + " --out=" + out.string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.errors.find("not an evfs video work folder"), std::string::npos)
+      << result.errors;
+  EXPECT_EQ(ReadFile(work / "notes.txt"), "precious");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(EvfsVideo, BadFlagsAreOneLineUserErrors) {
+  const fs::path root = test::ScratchDir("video_bad_flags");
+  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  const fs::path out = root / "out";
+  const std::string base = "video --data=" + data + " --out=" + out.string();
+  test::ExpectUserError(RunEvfs(base + " --frame_step=0"), "--frame_step", out);
+  test::ExpectUserError(RunEvfs(base + " --jobs=-1"), "--jobs", out);
+  test::ExpectUserError(RunEvfs(base + " --fps=-5"), "--fps", out);
+  test::ExpectUserError(RunEvfs(base + " --first=1 --last=9"), "3 frames", out);
+  test::ExpectUserError(RunEvfs("video --data=" + data), "--out", out);
+  test::ExpectUserError(RunEvfs(base + " --jobs=two"), "--jobs", out);
+}
+
+TEST(EvfsVideo, AnUnreadableFrameIsNamedOrSkipped) {
+  const fs::path root = test::ScratchDir("video_bad_frame");
+  const std::string data = WriteRecording(root, 4, 5, 24, 16);
+  const auto source = DataSource::Open(data);
+  const std::string broken = source->frames()[2].path;
+  test::WriteFile((fs::path(data) / broken).string(), "not a png");
+  const fs::path out = root / "out";
+  const std::string base = "video --data=" + data + " --out=" + out.string() + " --fps=1000";
+  test::ExpectUserError(RunEvfs(base), "frame 2", out);
+  const CommandResult skipped = RunEvfs(base + " --skip_bad_frames");
+  ASSERT_EQ(skipped.exit_code, 0) << skipped.output;
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["skipped_frames"], nlohmann::json::array({2}));
+  EXPECT_EQ(summary["windows"][1]["frames"][1]["index"], 3);  // across the gap
+}
+
+}  // namespace
+}  // namespace evfs
