@@ -102,7 +102,8 @@ std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string&
       if (entry.path().extension() != ".json") continue;
       try {
         Json record = Json::parse(ReadWholeFile(entry.path()));
-        done[record.at("index").get<int>()] = std::move(record);
+        const int index = record.at("index").get<int>();
+        done[index] = std::move(record);
       } catch (const std::exception&) {
         // An unreadable record is a window to solve again.
       }
@@ -447,10 +448,20 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
 
   double fps = request.fps;
   if (fps == 0.0) {
-    // The observed frames' mean rate over the video, times the upsampling.
-    const double span_s =
-        NanosecondsToSeconds(windows.back().output_end_ns - windows.front().output_begin_ns);
-    const double observed_rate = windows.size() / std::max(span_s, 1e-9);
+    // The observed frames' mean rate (over the interpolation windows, or the one window's
+    // length when there are none), times the upsampling.
+    int gaps = 0;
+    int64_t span_ns = 0;
+    for (const VideoWindow& window : windows) {
+      if (window.kind != VideoWindowKind::kInterpolate) continue;
+      ++gaps;
+      span_ns += window.output_end_ns - window.output_begin_ns;
+    }
+    if (gaps == 0) {
+      gaps = 1;
+      span_ns = windows.front().output_end_ns - windows.front().output_begin_ns;
+    }
+    const double observed_rate = gaps / std::max(NanosecondsToSeconds(span_ns), 1e-9);
     fps = std::round(kDefaultUpsampling * observed_rate);
     fps = std::max(fps, 1.0);
   }
@@ -471,7 +482,11 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
               << "settings " << request.settings << "\n"
               << PlanText(windows, clock);
   const fs::path work = VideoWorkFolder(out_path);
-  std::map<int, Json> records = PrepareWorkFolder(work, fingerprint.str(), request.resume);
+  const VideoDistribution* distribution = request.distribution;
+  const bool worker = distribution != nullptr && !distribution->coordinator;
+  // A worker process writes into the work folder its coordinator prepared.
+  std::map<int, Json> records =
+      worker ? std::map<int, Json>() : PrepareWorkFolder(work, fingerprint.str(), request.resume);
   // The work folder outlives a signal (that is what --resume is for), not an error: a run that
   // failed leaves nothing behind.
   struct RemoveOnError {
@@ -481,8 +496,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
       std::error_code ignored;
       if (armed) fs::remove_all(folder, ignored);
     }
-  } remove_on_error{work};
-  std::fprintf(stderr, "DEBUG records %zu\n", records.size());
+  } remove_on_error{work, !worker};
   for (auto it = records.begin(); it != records.end();) {
     // A recorded window is reused only when every frame it wrote is still there.
     bool complete = it->first >= 0 && it->first < result.windows;
@@ -523,26 +537,53 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   progress.windows_done = progress.windows_resumed = result.windows_resumed;
   std::atomic<bool> failed(false);
   const auto solve_start = Clock::now();
-  ParallelForEach(static_cast<int>(pending.size()), result.jobs, [&](int k) {
-    if (failed) return;  // an earlier window failed: the run ends with its error
-    try {
-      Json record = RunWindow(windows[pending[k]], context);
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      progress.events_done += record["events"].get<int64_t>();
-      ++progress.windows_done;
-      progress.elapsed_s = SecondsSince(solve_start);
-      records[pending[k]] = std::move(record);
-      if (request.progress) request.progress(progress);
-    } catch (...) {
-      failed = true;
-      throw;
+  // Each of the --jobs threads takes the next window as it becomes free: from the pending
+  // list, or, in a worker process, from its coordinator.
+  std::mutex take_mutex;
+  size_t next_pending = 0;
+  int solved = 0;
+  const auto take = [&]() -> int {
+    const std::lock_guard<std::mutex> lock(take_mutex);
+    if (failed) return -1;  // an earlier window failed: the run ends with its error
+    if (worker) return distribution->next();
+    return next_pending < pending.size() ? pending[next_pending++] : -1;
+  };
+  if (distribution != nullptr && distribution->coordinator) {
+    distribution->serve(pending);
+    // The workers' records, as they wrote them.
+    records = PrepareWorkFolder(work, fingerprint.str(), /*resume=*/true);
+    solved = static_cast<int>(pending.size());
+    for (const int index : pending) {
+      if (records.count(index) != 0)
+        progress.events_done += records[index]["events"].get<int64_t>();
     }
-  });
+  } else {
+    ParallelForEach(result.jobs, result.jobs, [&](int) {
+      for (int index = take(); index >= 0; index = take()) {
+        try {
+          Json record = RunWindow(windows[index], context);
+          const std::lock_guard<std::mutex> lock(progress_mutex);
+          progress.events_done += record["events"].get<int64_t>();
+          ++progress.windows_done;
+          ++solved;
+          progress.elapsed_s = SecondsSince(solve_start);
+          records[index] = std::move(record);
+          if (request.progress) request.progress(progress);
+        } catch (...) {
+          failed = true;
+          throw;
+        }
+      }
+    });
+  }
   result.solve_wall_s = SecondsSince(solve_start);
-  const int solved = static_cast<int>(pending.size());
   result.windows_per_s = result.solve_wall_s > 0.0 ? solved / result.solve_wall_s : 0.0;
   result.events_per_s =
       result.solve_wall_s > 0.0 ? progress.events_done / result.solve_wall_s : 0.0;
+  if (worker) {
+    remove_on_error.armed = false;
+    return result;
+  }
 
   // Assembly, in the OutputTarget's staging folder.
   const fs::path out = staging;

@@ -46,6 +46,19 @@ struct VideoProgress {
   double elapsed_s = 0.0;
 };
 
+/// How the windows of a video are shared between processes (app/video_mpi.h): one coordinator
+/// hands windows out as workers ask for them and assembles the output; the workers solve them
+/// and write their frames into the coordinator's work folder (a file system they share).
+struct VideoDistribution {
+  /// This process is the coordinator: it solves no window itself.
+  bool coordinator = false;
+  /// Coordinator: hands out the windows in `pending` (indices) on request and returns once
+  /// every worker has finished.
+  std::function<void(const std::vector<int>& pending)> serve;
+  /// Worker: the next window to solve, -1 when there is none. Called by one thread at a time.
+  std::function<int()> next;
+};
+
 struct VideoRequest {
   std::string data_path;   // data folder, HDF5 or AEDAT 4 file
   std::string data_label;  // how summary.json names the data ("": data_path)
@@ -64,6 +77,9 @@ struct VideoRequest {
   std::string settings;
   /// Called after each window, from the worker threads, one call at a time; may be empty.
   std::function<void(const VideoProgress&)> progress;
+  /// Windows shared with other processes; null: every window in this one. A worker returns
+  /// after its windows, writing nothing into `staging`.
+  const VideoDistribution* distribution = nullptr;
 
   bool IsValid(std::string* error) const;
 };

@@ -2,6 +2,7 @@
 //
 //   denoiser_benchmark [--weights=FILE.onnx] [--data=../shared/data] [--parts=speed,quality]
 //                      [--runs=10] [--csv=FILE] [--out=PICTURE_DIR] [--cases=NAME,...]
+//                      [--clip_crop_px=N]
 //                      [--pnp_iterations=N --pnp_rho=R --pnp_rho_growth=G]
 //
 // speed: ms per 240×180 frame (median of --runs) with 5 %, 25 % and 100 % of the pixels active
@@ -51,6 +52,8 @@ DEFINE_string(csv, "", "Also write the quality rows as CSV to this file.");
 DEFINE_string(out, "",
               "Write a picture per quality case (DMR | DMR + RD | truth, a zoomed crop below) "
               "as PNG into this folder.");
+DEFINE_int32(clip_crop_px, 0,
+             "Keep the central N x N pixels of the adobe240 clips (0: whole 500x500 frames).");
 DEFINE_string(cases, "",
               "Only the quality cases whose name contains one of these (comma list); empty: all.");
 DEFINE_int32(pnp_iterations, evfs::PlugAndPlayOptions().iterations,
@@ -284,7 +287,7 @@ QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last
 
 // A case on a 240 fps clip with simulated events, through RunMethod on the scene.
 QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& denoiser) {
-  const SimulatedClip clip = LoadSimulatedClip(FLAGS_data, clip_name);
+  const SimulatedClip clip = LoadSimulatedClip(FLAGS_data, clip_name, FLAGS_clip_crop_px);
   const BinningOptions binning;
   const Scene scene =
       deblur ? MakeClipDeblurScene(clip, binning) : MakeClipInterpolationScene(clip, binning);

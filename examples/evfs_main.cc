@@ -22,6 +22,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,6 +38,7 @@
 #include "app/simulate_job.h"
 #include "app/version_report.h"
 #include "app/video_job.h"
+#include "app/video_mpi.h"
 #include "core/enum_names.h"
 #include "core/error.h"
 #include "core/time.h"
@@ -463,7 +465,36 @@ int RunVideoCommand(ProgressReporter* progress) {
   request.settings = VideoSettings();
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
-  OutputTarget out(OutputFromFlags("video", FLAGS_data));
+  // Under mpirun: rank 0 writes, the other ranks solve the windows it hands out.
+  std::unique_ptr<MpiVideoSession> mpi;
+  if (LaunchedAsMpiJob()) mpi = std::make_unique<MpiVideoSession>();
+  if (mpi != nullptr && mpi->rank() != 0) {
+    const std::string out_path = mpi->Broadcast("");
+    if (out_path.empty()) return kExitUserError;  // rank 0 refused --out and said why
+    request.distribution = &mpi->distribution();
+    try {
+      RunVideo(request, out_path, "");
+    } catch (const Error& failure) {
+      std::fprintf(stderr, "evfs video: rank %d: %s\n", mpi->rank(), failure.what());
+      std::fflush(stderr);
+      mpi->WorkerFailed();  // rank 0 cleans up, then ends every rank
+      return kExitUserError;
+    }
+    mpi->WorkerFinished();
+    return 0;
+  }
+  std::unique_ptr<OutputTarget> target;
+  try {
+    target = std::make_unique<OutputTarget>(OutputFromFlags("video", FLAGS_data));
+  } catch (const Error&) {
+    if (mpi != nullptr) mpi->Broadcast("");
+    throw;
+  }
+  OutputTarget& out = *target;
+  if (mpi != nullptr) {
+    mpi->Broadcast(out.path());
+    request.distribution = &mpi->distribution();
+  }
   const bool terminal = ::isatty(STDERR_FILENO);
   request.progress = [progress, terminal](const VideoProgress& state) {
     const std::string line = VideoProgressLine(state);
@@ -475,7 +506,16 @@ int RunVideoCommand(ProgressReporter* progress) {
     }
   };
   progress->StartStage("windows");
-  const VideoResult result = RunVideo(request, out.path(), out.staging());
+  VideoResult result;
+  try {
+    result = RunVideo(request, out.path(), out.staging());
+  } catch (const Error& failure) {
+    if (mpi == nullptr) throw;
+    // The workers wait for windows: one line, then every rank ends.
+    std::fprintf(stderr, "evfs video: %s\n", failure.what());
+    target.reset();
+    mpi->Abort(kExitUserError);
+  }
   out.Commit();
   RemoveVideoWorkFolder(out.path());
   for (const int frame : result.skipped_frames) {

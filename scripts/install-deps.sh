@@ -21,6 +21,8 @@ packages=(
   python3-matplotlib
   # The Python module (python/) and its pytest suite.
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
+  # mpirun -np N evfs video (app/video_mpi.cc, EVFS_WITH_MPI); evfs builds without it too.
+  libopenmpi-dev openmpi-bin
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-dev)

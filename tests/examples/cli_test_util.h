@@ -87,13 +87,15 @@ inline void ExpectUserError(const CommandResult& result, const std::string& expe
   ExpectNoStagingLeft(out);
 }
 
-// A small synthetic recording written as a data folder: 5 frames 5 ms apart, events simulated
-// from a 1 kHz rendering.
-inline std::string WriteSyntheticFolder(const std::string& scratch) {
+// A small synthetic recording written as SCRATCH/data: `num_frames` frames `frame_step_ms` apart
+// on a `width` x `height` sensor, events simulated from a 1 kHz rendering of two moving shapes.
+// The defaults make 5 frames 5 ms apart at 40x32.
+inline std::string WriteSyntheticFolder(const std::string& scratch, int num_frames = 5,
+                                        int frame_step_ms = 5, int width = 40, int height = 32) {
   SceneOptions scene;
-  scene.width = 40;
-  scene.height = 32;
-  scene.duration_s = 0.02;
+  scene.width = width;
+  scene.height = height;
+  scene.duration_s = (num_frames - 1) * frame_step_ms / 1000.0;
   scene.num_shapes = 2;
   scene.min_shape_size_px = 5.0;
   scene.max_shape_size_px = 10.0;
@@ -101,7 +103,7 @@ inline std::string WriteSyntheticFolder(const std::string& scratch) {
   const EventStream events = SimulateEvents(rendered, SimulatorOptions());
   std::vector<FrameInfo> frames;
   std::vector<Image> images;
-  for (int t = 0; t < rendered.num_frames(); t += 5) {
+  for (int t = 0; t < rendered.num_frames(); t += frame_step_ms) {
     FrameInfo info;
     info.t_ns = rendered.timestamp_ns(t);
     info.path = "images/frame_" + std::to_string(t) + ".png";
@@ -111,6 +113,21 @@ inline std::string WriteSyntheticFolder(const std::string& scratch) {
   const std::string folder = (fs::path(scratch) / "data").string();
   WriteDataFolder(folder, events, frames, images);
   return folder;
+}
+
+// Starts evfs with `arguments` in the background (the caller waits for the returned pid), its
+// stdout and stderr in FOLDER/stdout.txt and FOLDER/stderr.txt.
+inline pid_t StartEvfs(const std::vector<std::string>& arguments, const fs::path& folder) {
+  const pid_t pid = fork();
+  if (pid != 0) return pid;
+  const std::string out = (folder / "stdout.txt").string();
+  const std::string err = (folder / "stderr.txt").string();
+  if (!freopen(out.c_str(), "w", stdout) || !freopen(err.c_str(), "w", stderr)) _exit(120);
+  std::vector<char*> argv = {const_cast<char*>(EVFS_BINARY)};
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  execv(EVFS_BINARY, argv.data());
+  _exit(121);
 }
 
 }  // namespace test

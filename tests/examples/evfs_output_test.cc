@@ -27,6 +27,7 @@ using test::CommandResult;
 using test::ExpectNoStagingLeft;
 using test::ReadFile;
 using test::RunEvfs;
+using test::StartEvfs;
 using test::WriteSyntheticFolder;
 
 // A sandbox: a synthetic recording in data/, stand-ins for home and the current folder, and a
@@ -220,20 +221,6 @@ TEST(EvfsOutput, ABadOutFailsBeforeAnyInputIsRead) {
         << "read the input before checking --out: " << result.errors;
   }
   sandbox.ExpectUntouched();
-}
-
-// Starts evfs with `arguments` in the background, output to files in `folder`.
-pid_t StartEvfs(const std::vector<std::string>& arguments, const fs::path& folder) {
-  const pid_t pid = fork();
-  if (pid != 0) return pid;
-  const std::string out = (folder / "stdout.txt").string();
-  const std::string err = (folder / "stderr.txt").string();
-  if (!freopen(out.c_str(), "w", stdout) || !freopen(err.c_str(), "w", stderr)) _exit(120);
-  std::vector<char*> argv = {const_cast<char*>(EVFS_BINARY)};
-  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
-  argv.push_back(nullptr);
-  execv(EVFS_BINARY, argv.data());
-  _exit(121);
 }
 
 // The staging folder of --out=`out` once it holds `frame`, or "" after `timeout`.

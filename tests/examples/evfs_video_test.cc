@@ -18,11 +18,8 @@
 #include <vector>
 
 #include "core/video.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
 #include "io/data_source.h"
 #include "io/image_io.h"
-#include "io/text_folder.h"
 #include "tests/examples/cli_test_util.h"
 #include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
@@ -35,33 +32,8 @@ namespace fs = std::filesystem;
 using test::CommandResult;
 using test::ReadFile;
 using test::RunEvfs;
-
-// A recording of `num_frames` frames `frame_step_ms` apart, rendered at 1 kHz, with events
-// simulated from the rendering.
-std::string WriteRecording(const fs::path& root, int num_frames, int frame_step_ms, int width,
-                           int height) {
-  SceneOptions scene;
-  scene.width = width;
-  scene.height = height;
-  scene.duration_s = (num_frames - 1) * frame_step_ms / 1000.0;
-  scene.num_shapes = 2;
-  scene.min_shape_size_px = 5.0;
-  scene.max_shape_size_px = 10.0;
-  const Video rendered = SceneSynthesizer(scene).RenderAtRate(1000.0);
-  const EventStream events = SimulateEvents(rendered, SimulatorOptions());
-  std::vector<FrameInfo> frames;
-  std::vector<Image> images;
-  for (int t = 0; t < rendered.num_frames(); t += frame_step_ms) {
-    FrameInfo info;
-    info.t_ns = rendered.timestamp_ns(t);
-    info.path = "images/frame_" + std::to_string(t) + ".png";
-    frames.push_back(info);
-    images.push_back(rendered.frame(t));
-  }
-  const std::string folder = (root / "data").string();
-  WriteDataFolder(folder, events, frames, images);
-  return folder;
-}
+using test::StartEvfs;
+using test::WriteSyntheticFolder;
 
 // frames/NNNNNN.png
 std::string FrameFileName(int n) {
@@ -93,7 +65,7 @@ void ExpectSameFrames(const fs::path& a, const fs::path& b) {
 
 TEST(EvfsVideo, AWholeRecordingBecomesUniformFramesWithTheObservedOnesUnchanged) {
   const fs::path root = test::ScratchDir("video_end_to_end");
-  const std::string data = WriteRecording(root, 5, 5, 40, 32);
+  const std::string data = WriteSyntheticFolder(root.string(), 5, 5, 40, 32);
   const fs::path out = root / "out";
   const CommandResult result =
       RunEvfs("video --data=" + data + " --out=" + out.string() + " --fps=1000 --jobs=1");
@@ -145,7 +117,7 @@ TEST(EvfsVideo, AWholeRecordingBecomesUniformFramesWithTheObservedOnesUnchanged)
 
 TEST(EvfsVideo, WindowsWithoutEventsAreAnsweredWithoutASolve) {
   const fs::path root = test::ScratchDir("video_no_events");
-  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  const std::string data = WriteSyntheticFolder(root.string(), 3, 5, 24, 16);
   // The same frames with an empty events.txt.
   test::WriteFile((fs::path(data) / "events.txt").string(), "");
   const fs::path out = root / "out";
@@ -163,7 +135,7 @@ TEST(EvfsVideo, WindowsWithoutEventsAreAnsweredWithoutASolve) {
 
 TEST(EvfsVideo, OneJobAndTwoJobsWriteTheSameFrames) {
   const fs::path root = test::ScratchDir("video_jobs");
-  const std::string data = WriteRecording(root, 7, 5, 40, 32);
+  const std::string data = WriteSyntheticFolder(root.string(), 7, 5, 40, 32);
   const std::string common = "video --data=" + data + " --fps=700 --preview";
   const CommandResult one = RunEvfs(common + " --jobs=1 --out=" + (root / "one").string());
   ASSERT_EQ(one.exit_code, 0) << one.output;
@@ -173,24 +145,10 @@ TEST(EvfsVideo, OneJobAndTwoJobsWriteTheSameFrames) {
   EXPECT_GT(fs::file_size(root / "two" / "preview.mp4"), 0u);
 }
 
-// Starts evfs with `arguments` in the background, its output in files in `folder`.
-pid_t StartEvfs(const std::vector<std::string>& arguments, const fs::path& folder) {
-  const pid_t pid = fork();
-  if (pid != 0) return pid;
-  const std::string out = (folder / "stdout.txt").string();
-  const std::string err = (folder / "stderr.txt").string();
-  if (!freopen(out.c_str(), "w", stdout) || !freopen(err.c_str(), "w", stderr)) _exit(120);
-  std::vector<char*> argv = {const_cast<char*>(EVFS_BINARY)};
-  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
-  argv.push_back(nullptr);
-  execv(EVFS_BINARY, argv.data());
-  _exit(121);
-}
-
 TEST(EvfsVideo, AnInterruptedRunResumesIntoTheSameOutput) {
   const fs::path root = test::ScratchDir("video_resume");
   // 30 windows, solved one at a time: the run is stopped after its first windows.
-  const std::string data = WriteRecording(root, 31, 4, 64, 48);
+  const std::string data = WriteSyntheticFolder(root.string(), 31, 4, 64, 48);
   const std::vector<std::string> arguments = {"video", "--data=" + data, "--fps=500", "--jobs=1",
                                               "--threads=1"};
   std::vector<std::string> reference = arguments;
@@ -229,9 +187,29 @@ TEST(EvfsVideo, AnInterruptedRunResumesIntoTheSameOutput) {
   EXPECT_FALSE(fs::exists(work));
 }
 
+#ifdef EVFS_MPIRUN
+// mpirun -np 2: rank 0 hands the windows to rank 1 and writes; the frames are those of one
+// process.
+TEST(EvfsVideo, TwoMpiRanksWriteTheSameFramesAsOneProcess) {
+  const fs::path root = test::ScratchDir("video_mpi");
+  const std::string data = WriteSyntheticFolder(root.string(), 7, 5, 40, 32);
+  const std::string common = "video --data=" + data + " --fps=700 --jobs=1 --threads=1";
+  const CommandResult single = RunEvfs(common + " --out=" + (root / "single").string());
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+  const CommandResult ranks =
+      RunEvfs(common + " --out=" + (root / "ranks").string(),
+              std::string(EVFS_MPIRUN) + " --allow-run-as-root --oversubscribe -np 2 ");
+  ASSERT_EQ(ranks.exit_code, 0) << ranks.output;
+  ExpectSameFrames(root / "single", root / "ranks");
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(root / "ranks" / "summary.json"));
+  EXPECT_EQ(summary["windows"].size(), 6u);  // 7 frames: 6 gaps, no events after the last
+  EXPECT_FALSE(fs::exists(root / ".ranks.evfs-video-work"));
+}
+#endif
+
 TEST(EvfsVideo, ResumeWithOtherSettingsIsRefused) {
   const fs::path root = test::ScratchDir("video_resume_settings");
-  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  const std::string data = WriteSyntheticFolder(root.string(), 3, 5, 24, 16);
   // An interrupted run's work folder, as evfs leaves it.
   const fs::path work = root / ".out.evfs-video-work";
   fs::create_directories(work / "windows");
@@ -251,7 +229,7 @@ TEST(EvfsVideo, ResumeWithOtherSettingsIsRefused) {
 
 TEST(EvfsVideo, AWorkFolderPathEvfsDidNotMarkIsNeverTouched) {
   const fs::path root = test::ScratchDir("video_foreign_work");
-  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  const std::string data = WriteSyntheticFolder(root.string(), 3, 5, 24, 16);
   const fs::path work = root / ".out.evfs-video-work";
   fs::create_directories(work);
   test::WriteFile((work / "notes.txt").string(), "precious");
@@ -266,7 +244,7 @@ TEST(EvfsVideo, AWorkFolderPathEvfsDidNotMarkIsNeverTouched) {
 
 TEST(EvfsVideo, BadFlagsAreOneLineUserErrors) {
   const fs::path root = test::ScratchDir("video_bad_flags");
-  const std::string data = WriteRecording(root, 3, 5, 24, 16);
+  const std::string data = WriteSyntheticFolder(root.string(), 3, 5, 24, 16);
   const fs::path out = root / "out";
   const std::string base = "video --data=" + data + " --out=" + out.string();
   test::ExpectUserError(RunEvfs(base + " --frame_step=0"), "--frame_step", out);
@@ -279,7 +257,7 @@ TEST(EvfsVideo, BadFlagsAreOneLineUserErrors) {
 
 TEST(EvfsVideo, AnUnreadableFrameIsNamedOrSkipped) {
   const fs::path root = test::ScratchDir("video_bad_frame");
-  const std::string data = WriteRecording(root, 4, 5, 24, 16);
+  const std::string data = WriteSyntheticFolder(root.string(), 4, 5, 24, 16);
   const auto source = DataSource::Open(data);
   const std::string broken = source->frames()[2].path;
   test::WriteFile((fs::path(data) / broken).string(), "not a png");
