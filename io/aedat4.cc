@@ -1210,7 +1210,7 @@ class Aedat4Writer {
 };
 
 // The XML stream description DV writes (see the IOHeader of a DV recording), plus the evfs node.
-std::string StreamDescription(int width, int height, bool with_frames,
+std::string StreamDescription(int width, int height, bool with_events, bool with_frames,
                               Aedat4Compression compression, const std::vector<FrameInfo>& frames) {
   tinyxml2::XMLDocument document;
   const auto add_node = [&](tinyxml2::XMLElement* parent, const std::string& name,
@@ -1249,7 +1249,9 @@ std::string StreamDescription(int width, int height, bool with_frames,
     // The stored times are the recording's own; nothing was added to them.
     add_attr(info, "tsOffset", "long", "0");
   };
-  add_stream(kEventsStreamId, kEventsType, "events", "Array of events (polarity ON/OFF).");
+  if (with_events) {
+    add_stream(kEventsStreamId, kEventsType, "events", "Array of events (polarity ON/OFF).");
+  }
   if (with_frames) {
     add_stream(kFramesStreamId, kFramesType, "frames", "Standard frame (8-bit image).");
   }
@@ -1276,6 +1278,10 @@ void WriteAedat4(const std::string& path, const EventStream& events,
   if (frames.size() != images.size()) {
     throw InvalidArgumentError("WriteAedat4: " + std::to_string(frames.size()) + " frames but " +
                                std::to_string(images.size()) + " images");
+  }
+  if (!options.with_events && !events.empty()) {
+    throw InvalidArgumentError("WriteAedat4: a file without an event stream cannot hold " +
+                               std::to_string(events.size()) + " events");
   }
   int width = events.width();
   int height = events.height();
@@ -1325,8 +1331,8 @@ void WriteAedat4(const std::string& path, const EventStream& events,
   }
 
   Aedat4Writer writer(path, options.compression);
-  const std::string description =
-      StreamDescription(width, height, !frames.empty(), options.compression, frames);
+  const std::string description = StreamDescription(width, height, options.with_events,
+                                                    !frames.empty(), options.compression, frames);
   writer.WriteHeader(description, /*data_table_position=*/-1);
 
   const size_t chunk = static_cast<size_t>(options.max_events_per_packet);

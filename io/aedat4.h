@@ -47,6 +47,8 @@ struct Aedat4WriteOptions {
   /// Most events in one packet: a windowed read decompresses whole packets, so this is the
   /// granularity of seeking (8192 events are 128 KB decompressed).
   int max_events_per_packet = 8192;
+  /// false: a recording of frames only, without an event stream (`events` must be empty).
+  bool with_events = true;
 
   bool IsValid(std::string* error) const;
 };

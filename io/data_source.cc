@@ -50,7 +50,11 @@ std::unique_ptr<DataSource> DataSource::Open(const std::string& path) {
 
 void ConvertRecording(const std::string& input, const std::string& output) {
   const std::unique_ptr<DataSource> source = DataSource::Open(input);
-  const EventStream events = source->ReadAllEvents();
+  // A recording of frames only stays one in a data folder or an AEDAT 4 file; the HDF5 layout
+  // holds events, so there ReadAllEvents refuses it (naming `evfs simulate`).
+  const bool with_events = source->has_events() || IsHdf5Path(output);
+  const EventStream events =
+      with_events ? source->ReadAllEvents() : EventStream(source->width(), source->height());
   std::vector<Image> images;
   for (int i = 0; i < static_cast<int>(source->frames().size()); ++i) {
     images.push_back(source->ReadImage(i));
@@ -58,9 +62,11 @@ void ConvertRecording(const std::string& input, const std::string& output) {
   if (IsHdf5Path(output)) {
     WriteHdf5(output, events, source->frames(), images);
   } else if (IsAedat4Path(output)) {
-    WriteAedat4(output, events, source->frames(), images);
+    Aedat4WriteOptions options;
+    options.with_events = with_events;
+    WriteAedat4(output, events, source->frames(), images, options);
   } else {
-    WriteDataFolder(output, events, source->frames(), images);
+    WriteDataFolder(output, events, source->frames(), images, with_events);
   }
 }
 

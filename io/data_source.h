@@ -102,7 +102,8 @@ bool IsHdf5Path(const std::string& path);
 /// path gives HDF5, an .aedat4 path AEDAT 4, anything else a data folder), losslessly: events to
 /// the nanosecond, frames with their pixel values and bit depth, timestamps, exposures and
 /// images.txt paths. AEDAT 4 keeps times to the microsecond and 8-bit frames only (WriteAedat4
-/// rounds the times and refuses finer pixels).
+/// rounds the times and refuses finer pixels). A recording of frames only (has_events() false)
+/// stays one in a data folder or an AEDAT 4 file; HDF5 refuses it, as it holds events.
 void ConvertRecording(const std::string& input, const std::string& output);
 
 }  // namespace evfs

@@ -142,10 +142,15 @@ EventSummary TextFolderDataSource::Summarize() const {
 }
 
 void WriteDataFolder(const std::string& folder, const EventStream& events,
-                     const std::vector<FrameInfo>& frames, const std::vector<Image>& images) {
+                     const std::vector<FrameInfo>& frames, const std::vector<Image>& images,
+                     bool with_events) {
   if (frames.size() != images.size()) {
     throw InvalidArgumentError("WriteDataFolder: " + std::to_string(frames.size()) +
                                " frames but " + std::to_string(images.size()) + " images");
+  }
+  if (!with_events && !events.empty()) {
+    throw InvalidArgumentError("WriteDataFolder: a folder of frames only cannot hold " +
+                               std::to_string(events.size()) + " events");
   }
   std::error_code error;
   fs::create_directories(folder, error);
@@ -153,7 +158,7 @@ void WriteDataFolder(const std::string& folder, const EventStream& events,
     throw InputError(InputError::Kind::kUnwritable, folder, 0,
                      "cannot create the folder: " + error.message());
   }
-  WriteEventsText((fs::path(folder) / kEventsFile).string(), events);
+  if (with_events) WriteEventsText((fs::path(folder) / kEventsFile).string(), events);
 
   std::vector<FrameInfo> written = frames;
   bool any_exposure = false;

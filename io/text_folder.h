@@ -44,9 +44,11 @@ class TextFolderDataSource : public DataSource {
 /// frame has an exposure. A frame keeps its `path` when it is a relative .png path inside the
 /// folder; otherwise (for instance an HDF5 dataset name) it becomes images/frame_XXXXXXXX.png
 /// with XXXXXXXX the frame index. `images[i]` is the pixel data of `frames[i]`. Throws
-/// InputError(kUnwritable), or InvalidArgumentError when the sizes disagree.
+/// InputError(kUnwritable), or InvalidArgumentError when the sizes disagree. `with_events` false
+/// writes a recording of frames only: no events.txt (`events` must be empty).
 void WriteDataFolder(const std::string& folder, const EventStream& events,
-                     const std::vector<FrameInfo>& frames, const std::vector<Image>& images);
+                     const std::vector<FrameInfo>& frames, const std::vector<Image>& images,
+                     bool with_events = true);
 
 }  // namespace evfs
 

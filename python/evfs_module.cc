@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "app/reconstruct_job.h"
+#include "app/video_job.h"
 #include "core/error.h"
 #include "core/event_stream.h"
 #include "core/time.h"
@@ -23,6 +24,7 @@
 #include "core/video.h"
 #include "events/simulator.h"
 #include "io/data_source.h"
+#include "io/output_target.h"
 #include "python/array_source.h"
 #include "python/reconstruct_options.h"
 
@@ -322,6 +324,73 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
   return EventsDict(std::move(events));
 }
 
+// evfs.video: `evfs video` without MPI, into a folder through the same OutputTarget (so the
+// same refusals and the same atomic replacement). Unlike the command line it runs in this
+// process: a signal leaves the staging folder, and the resumable work folder, behind.
+py::dict VideoFromPath(const std::string& data, const std::string& out, int first, int last,
+                       double fps, int jobs, int frame_step, bool predict_tail, bool preview,
+                       bool resume, bool overwrite, py::handle options) {
+  ReconstructSettings settings = DefaultReconstructSettings();
+  ApplyReconstructOptions(options, &settings);
+  ResolveDenoise(&settings);
+  VideoRequest request;
+  request.data_path = data;
+  request.windows.first = first;
+  request.windows.last = last;
+  request.windows.frame_step = frame_step;
+  request.windows.predict_tail = predict_tail;
+  request.fps = fps;
+  request.jobs = jobs;
+  request.preview = preview;
+  request.resume = resume;
+  request.binning = settings.request.binning;
+  request.method = settings.request.method;
+  request.denoise = settings.request.denoise;
+  // What --resume compares: everything that decides the frames (not jobs, resume, overwrite).
+  request.settings = std::string(py::str(ReconstructOptionValues(settings))) +
+                     " first=" + std::to_string(first) + " last=" + std::to_string(last) +
+                     " fps=" + std::to_string(fps) + " frame_step=" + std::to_string(frame_step) +
+                     " predict_tail=" + std::to_string(predict_tail) +
+                     " preview=" + std::to_string(preview);
+  std::string error;
+  if (!request.IsValid(&error)) throw InvalidArgumentError(error);
+  OutputOptions output;
+  output.path = out;
+  output.command = "video";
+  output.overwrite = overwrite;
+  output.inputs = {data};
+  VideoResult result;
+  std::string path;
+  {
+    py::gil_scoped_release release;
+    OutputTarget target(output);
+    result = RunVideo(request, target.path(), target.staging());
+    target.Commit();
+    RemoveVideoWorkFolder(target.path());
+    path = target.path();
+  }
+  py::dict summary;
+  summary["path"] = path;
+  summary["windows"] = result.windows;
+  summary["windows_resumed"] = result.windows_resumed;
+  summary["frames"] = result.output_frames;
+  summary["fps"] = result.fps;
+  summary["width"] = result.width;
+  summary["height"] = result.height;
+  summary["events"] = result.events;
+  summary["windows_per_s"] = result.windows_per_s;
+  summary["events_per_s"] = result.events_per_s;
+  summary["codec"] = result.codec;
+  if (result.truth_frames > 0) {
+    summary["truth_frames"] = result.truth_frames;
+    summary["mean_psnr"] = result.mean_psnr;
+    summary["worst_psnr"] = result.worst_psnr;
+    summary["mean_blend_psnr"] = result.mean_blend_psnr;
+    summary["mean_ssim"] = result.mean_ssim;
+  }
+  return summary;
+}
+
 }  // namespace
 }  // namespace evfs
 
@@ -368,6 +437,17 @@ PYBIND11_MODULE(evfs, m) {
         "Simulates the events of a sequence of frames (at least 2; frames x height x width "
         "float32 or float64 in [0, 1], float64 seconds), as `evfs simulate` does. options: "
         "simulate_defaults()'s keys. Returns the events as a dict like read()'s 'events'.");
+  m.def("video", &evfs::VideoFromPath, py::arg("data"), py::arg("out"), py::kw_only(),
+        py::arg("first") = 0, py::arg("last") = -1, py::arg("fps") = 0.0, py::arg("jobs") = 0,
+        py::arg("frame_step") = 1, py::arg("predict_tail") = true, py::arg("preview") = false,
+        py::arg("resume") = false, py::arg("overwrite") = false, py::arg("options") = py::none(),
+        "A whole recording (`data`: a path read() accepts) to one high-framerate video in the "
+        "folder `out`, as `evfs video` does (without MPI): out/frames/NNNNNN.png at a uniform "
+        "`fps` (0: 10x the frame rate), timestamps.txt, summary.json, video.mp4. first/last "
+        "select frames (-1: the last), jobs windows run at once (0: every core), frame_step > 1 "
+        "withholds frames and scores them, resume reuses an interrupted run's windows, "
+        "overwrite replaces an earlier evfs video output. options: reconstruct_defaults()'s "
+        "keys. Returns a dict: 'path', 'windows', 'frames', 'fps', 'events', 'codec', ... ");
   m.def(
       "reconstruct_defaults",
       [] { return evfs::ReconstructOptionValues(evfs::DefaultReconstructSettings()); },

@@ -464,3 +464,38 @@ def test_gil_released_during_solve(small):
     # counter runs on (gaps only where the OS or the interpreter's switch interval pauses it).
     gaps = np.diff(np.concatenate([[begin], during, [end]]))
     assert gaps.max() < 0.5 * duration, f"longest pause {gaps.max():.3f} s of {duration:.3f} s"
+
+
+# ---------------------------------------------------------------------------------------------
+# video
+
+
+def read_frame_folder(folder):
+    """The 16-bit frames (as written) and the timestamps.txt lines of a video output."""
+    frames, _ = read_cli_reconstruction(str(folder))
+    with open(os.path.join(folder, "timestamps.txt")) as lines:
+        return frames, lines.read()
+
+
+def test_video_identical_to_cli(demo, tmp_path):
+    data = str(demo / "data")
+    status, _, stderr = run_cli("video", f"--data={data}", f"--out={tmp_path / 'cli'}",
+                                "--fps=400", "--jobs=1")
+    assert status == 0, stderr
+    result = evfs.video(data, str(tmp_path / "py"), fps=400, jobs=1)
+    assert result["frames"] > 0 and result["windows"] > 0
+    assert os.path.samefile(result["path"], tmp_path / "py")
+    cli_frames, cli_times = read_frame_folder(tmp_path / "cli")
+    py_frames, py_times = read_frame_folder(tmp_path / "py")
+    assert py_times == cli_times
+    np.testing.assert_array_equal(py_frames, cli_frames)
+    # An earlier output is replaced only with overwrite=True; a folder evfs did not write never.
+    with pytest.raises(ValueError, match="overwrite"):
+        evfs.video(data, str(tmp_path / "py"), fps=400, jobs=1)
+    evfs.video(data, str(tmp_path / "py"), fps=400, jobs=1, overwrite=True)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "keep.txt").write_text("user data")
+    with pytest.raises(ValueError):
+        evfs.video(data, str(foreign), fps=400, overwrite=True)
+    assert (foreign / "keep.txt").read_text() == "user data"
