@@ -17,9 +17,10 @@ const char* const kMp4Codecs[2] = {"avc1", "mp4v"};
 Mp4Writer::Mp4Writer(const std::string& path, double fps, int width, int height)
     : path_(path), width_(width), height_(height), writer_(std::make_unique<cv::VideoWriter>()) {
   // x264 with frame threads gave different bytes for the same frames from run to run of evfs
-  // (--jobs=1 against --jobs=2); one encoder thread makes the file a function of its frames,
-  // which resumed and distributed runs rely on. OpenCV reads its FFmpeg writer options from
-  // this variable; a user's own setting wins.
+  // (--jobs=1 against --jobs=2), so one encoder thread is asked for (OpenCV reads its FFmpeg
+  // writer options from this variable; a user's own setting wins). The bytes were still seen to
+  // differ between runs, so nothing relies on them: resumed and distributed runs are checked on
+  // frames/ and timestamps.txt (README, `evfs video`).
   setenv("OPENCV_FFMPEG_WRITER_OPTIONS", "threads;1", /*overwrite=*/0);
   for (const char* codec : kMp4Codecs) {
     const int fourcc = cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]);
