@@ -53,6 +53,7 @@ ProgramHelp MakeEvfsHelp() {
       {"last", "data", "info reconstruct video"},
       {"truth", "data", "reconstruct"},
       {"exposure_s", "data", "reconstruct video"},
+      {"frame_time", "data", "reconstruct"},
       // What is written.
       {"out", "output", "reconstruct denoise simulate convert demo video"},
       {"overwrite", "output", "reconstruct denoise simulate convert demo video"},
@@ -87,6 +88,7 @@ ProgramHelp MakeEvfsHelp() {
       {"activity_radius_px", "model", "reconstruct video"},
       {"merge_quiet_steps", "model", "reconstruct video"},
       {"split_independent_parts", "model", "reconstruct video"},
+      {"max_problem_mb", "model", "reconstruct video"},
       // Ceres.
       {"linear_solver", "solver", "reconstruct video"},
       {"preconditioner", "solver", "reconstruct video"},

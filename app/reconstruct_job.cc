@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "app/frame_lag.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
@@ -39,10 +40,25 @@ void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   }
 }
 
-TimedFrame ReadSharpFrame(const DataSource& source, int index) {
+// What moment a sharp frame represents (ReconstructRequest::frame_time), resolved.
+struct SharpFrameTiming {
+  FrameTime time = FrameTime::kInstant;
+  int64_t lag_ns = 0;       // kAuto (estimated) and kLag
+  int64_t exposure_ns = 0;  // kStart, kMiddle, kEnd when the data has no exposures
+};
+
+FrameSpan SharpFrameSpan(const DataSource& source, int index, const SharpFrameTiming& timing) {
+  const FrameInfo& info = source.frames()[index];
+  return ModelledFrameSpan(info.t_ns, info.has_exposure, info.exposure_begin_ns,
+                           info.exposure_end_ns, timing.time, timing.lag_ns, timing.exposure_ns);
+}
+
+TimedFrame ReadSharpFrame(const DataSource& source, int index, const SharpFrameTiming& timing) {
   TimedFrame frame;
   frame.image = source.ReadImage(index);
-  frame.exposure_begin_ns = frame.exposure_end_ns = source.frames()[index].t_ns;
+  const FrameSpan span = SharpFrameSpan(source, index, timing);
+  frame.exposure_begin_ns = span.begin_ns;
+  frame.exposure_end_ns = span.end_ns;
   frame.label = source.frames()[index].path;
   return frame;
 }
@@ -144,18 +160,35 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   }
   if (request.truth >= 0) CheckFrameIndex(*source, request.truth, "the truth");
 
+  // The moment each sharp frame represents. Auto estimates the lag from the input frames only
+  // (interpolate: the two; predict: the first and the one before it), never from the truth.
+  SharpFrameTiming timing{request.frame_time, SecondsToNanoseconds(request.frame_lag_s),
+                          SecondsToNanoseconds(request.exposure_s)};
+  if (request.mode != Mode::kDeblur && request.frame_time == FrameTime::kAuto) {
+    std::vector<int> inputs = {request.first, last};
+    if (request.mode == Mode::kPredict) inputs = {request.first - 1, request.first};
+    if (inputs.front() < 0 || inputs.front() == request.truth) inputs = {};
+    result.frame_lag = EstimateRecordingFrameLag(*source, inputs, request.frame_lag);
+    timing.lag_ns = result.frame_lag.lag_ns;
+  }
+  if (request.mode != Mode::kDeblur) {
+    result.frame_shift_ns = SharpFrameSpan(*source, request.first, timing).middle_ns() -
+                            source->frames()[request.first].t_ns;
+  }
+
   std::vector<TimedFrame> frames;
   int64_t window_begin_ns = 0, window_end_ns = 0;
   switch (request.mode) {
     case Mode::kInterpolate:
-      frames = {ReadSharpFrame(*source, request.first), ReadSharpFrame(*source, last)};
+      frames = {ReadSharpFrame(*source, request.first, timing),
+                ReadSharpFrame(*source, last, timing)};
       window_begin_ns = frames.front().exposure_begin_ns;
       window_end_ns = frames.back().exposure_end_ns;
       break;
     case Mode::kPredict:
-      frames = {ReadSharpFrame(*source, request.first)};
+      frames = {ReadSharpFrame(*source, request.first, timing)};
       window_begin_ns = frames.front().exposure_begin_ns;
-      window_end_ns = source->frames()[last].t_ns;
+      window_end_ns = SharpFrameSpan(*source, last, timing).middle_ns();
       break;
     case Mode::kDeblur:
       frames = {ReadBlurredFrame(*source, request.first, request.exposure_s)};
@@ -187,7 +220,10 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   CheckpointTruth checkpoint_truth;
   const bool score = request.truth >= 0;
   if (score) {
-    result.truth.timestamp_ns = source->frames()[request.truth].t_ns;
+    // The moment the truth frame represents, as for the inputs (deblur: its timestamp).
+    result.truth.timestamp_ns = request.mode == Mode::kDeblur
+                                    ? source->frames()[request.truth].t_ns
+                                    : SharpFrameSpan(*source, request.truth, timing).middle_ns();
     if (result.truth.timestamp_ns < window_begin_ns || result.truth.timestamp_ns > window_end_ns) {
       throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
                                  " lies outside the reconstructed window");
@@ -309,6 +345,9 @@ void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& p
   json["problem"] = {
       {"independent_parts", problem.parts},
       {"split_independent_parts", options.split_independent_parts},
+      {"batches", problem.batches},
+      {"estimated_mb", Number(static_cast<double>(problem.estimated_bytes) / (1 << 20))},
+      {"max_problem_mb", options.max_problem_mb},
       {"smoothing_continuation", continuation},
       {"parameter_blocks", problem.parameter_blocks},
       {"unknowns", problem.variable_parameter_blocks},
@@ -338,6 +377,23 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json["event_frames"] = result.event_frames;
   json["latent_frames"] = run.video.num_frames();
   json["output_frames"] = result.output.num_frames();
+  if (result.mode != Mode::kDeblur) {
+    // The moment the sharp frames were taken to represent (--frame_time).
+    Json timing = {
+        {"frame_time", FrameTimeName(request.frame_time, request.frame_lag_s)},
+        {"shift_ms", Number(1e3 * NanosecondsToSeconds(result.frame_shift_ns))},
+    };
+    if (request.frame_time == FrameTime::kAuto) {
+      const FrameLagEstimate& lag = result.frame_lag;
+      timing["lag_estimated"] = lag.estimated;
+      timing["lag_ms"] = Number(1e3 * NanosecondsToSeconds(lag.lag_ns));
+      timing["peak_lag_ms"] = Number(1e3 * NanosecondsToSeconds(lag.peak_lag_ns));
+      timing["correlation"] = Number(lag.peak_correlation);
+      timing["correlation_at_zero"] = Number(lag.correlation_at_zero);
+      timing["frame_pairs"] = lag.pairs;
+    }
+    json["frame_timing"] = std::move(timing);
+  }
   Json solver;
   solver["name"] = run.method;
   solver["message"] = run.message;

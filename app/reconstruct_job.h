@@ -13,6 +13,7 @@
 #include "core/enum_names.h"
 #include "core/video.h"
 #include "io/data_source.h"
+#include "scene/frame_timing.h"
 #include "scene/scene.h"
 
 namespace evfs {
@@ -39,6 +40,12 @@ struct ReconstructRequest {
   int truth = -1;  // frame to score against (-1: none)
   double exposure_s = 0.0;  // deblur: exposure around the frame's timestamp when the data has none
   double fps = 0.0;         // > 0: resample the latent video to this uniform rate
+  /// Interpolate, predict: the moment each sharp frame (inputs, the predicted frame, the truth)
+  /// represents (scene/frame_timing.h); kLag uses frame_lag_s, kAuto estimates it from the
+  /// frames first..last other than the truth, with frame_lag's options.
+  FrameTime frame_time = FrameTime::kInstant;
+  double frame_lag_s = 0.0;
+  FrameLagOptions frame_lag;
   BinningOptions binning;
   /// The method and all its settings (objective.event_model.alpha <= 0: derive α from the data).
   MethodOptions method;
@@ -79,6 +86,11 @@ struct ReconstructResult {
   TruthScore truth;
   StageTimes time;
   DenoiseRecord denoise;  // what the denoiser did (mode none: nothing)
+  /// request.frame_time kAuto: the estimate; frame_shift_ns: how far the moment a sharp frame
+  /// represents lies after its timestamp (the first frame's exposure middle for start, middle,
+  /// end).
+  FrameLagEstimate frame_lag;
+  int64_t frame_shift_ns = 0;
 };
 
 /// Runs the job. Throws evfs::Error (InputError, InvalidArgumentError) on bad input.

@@ -1,5 +1,8 @@
 #include "app/reports.h"
 
+#include <vector>
+
+#include "app/frame_lag.h"
 #include "core/enum_names.h"
 #include "core/error.h"
 #include "core/time.h"
@@ -88,6 +91,12 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
   const double last_mean = source.ReadImage(last).mean();
   std::fprintf(out, "brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", first,
                first_mean, last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
+  // When the frames show the scene relative to their timestamps, from the events between each
+  // pair of consecutive frames of the window (reconstruct's --frame_time=auto).
+  std::vector<int> indices;
+  for (int i = first; i <= last; ++i) indices.push_back(i);
+  std::fprintf(out, "frame time  %s\n",
+               EstimateRecordingFrameLag(source, indices, FrameLagOptions()).description.c_str());
 }
 
 void PrintReconstruction(const ReconstructRequest& request, const ReconstructResult& result,
@@ -99,6 +108,13 @@ void PrintReconstruction(const ReconstructRequest& request, const ReconstructRes
   if (result.hot_pixels > 0) {
     std::fprintf(out, "hot pixels: %d, their %lld events left out (--hot_pixel_factor)\n",
                  result.hot_pixels, static_cast<long long>(result.hot_pixel_events));
+  }
+  if (result.mode != Mode::kDeblur && request.frame_time != FrameTime::kInstant) {
+    std::fprintf(
+        out, "frame time: sharp frames shifted by %+.2f ms%s%s\n",
+        1e3 * NanosecondsToSeconds(result.frame_shift_ns),
+        request.frame_time == FrameTime::kAuto ? ": " : "",
+        request.frame_time == FrameTime::kAuto ? result.frame_lag.description.c_str() : "");
   }
   if (IsIterative(request.method.method)) {
     std::fprintf(out, "model: %s\n", run.reconstruction.model.description.c_str());

@@ -50,6 +50,8 @@ DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
             "one unknown per quiet run of a pixel (false: per voxel).");
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "solve uncoupled regions as separate concurrent problems (false: one problem).");
+DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
+             "Most memory (MiB) the Ceres problems hold at once; <= 0: no limit.");
 DEFINE_string(init, "blend", "blend | events: where the solve starts.");
 DEFINE_int32(clip_crop_px, 0, "Keep the central N x N pixels of each clip (0: whole frames).");
 DEFINE_int32(max_iterations, evfs::ReconstructionOptions().solver.max_num_iterations,
@@ -95,6 +97,7 @@ ReconstructionOptions Options() {
   options.objective.temporal_tv_weight = FLAGS_temporal_tv_weight;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
   options.split_independent_parts = FLAGS_split_independent_parts;
+  options.max_problem_mb = FLAGS_max_problem_mb;
   return options;
 }
 

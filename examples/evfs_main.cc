@@ -78,6 +78,12 @@ DEFINE_double(exposure_s, 0.0,
 DEFINE_double(fps, 0.0,
               "Resample the latent video to this uniform frame rate; 0 writes the "
               "latent frames themselves.");
+DEFINE_string(frame_time, "instant",
+              "interpolate, predict: the moment a sharp frame represents. instant: its "
+              "timestamp; auto: its timestamp plus the lag that best explains the input frames' "
+              "change by the events (evfs info --first --last prints it); a number: that lag in "
+              "ms; start | middle | end: the mean over its exposure (exposures.txt, else "
+              "--exposure_s) which the timestamp starts, centres or ends.");
 // Method.
 DEFINE_string(solver, "ceres_lm",
               "Method: ceres_lm (default: Levenberg-Marquardt in Ceres) | "
@@ -149,6 +155,10 @@ DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "Solve the regions that no term couples as separate problems, concurrently "
             "(one after another with --progress or --checkpoints); false: one problem.");
+DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
+             "Most memory (MiB) the Ceres problems hold at once, estimated before building: "
+             "larger problems are solved in batches of parts, or in overlapping bands of rows, "
+             "one after another; <= 0: no limit.");
 DEFINE_string(smoothing_continuation, "",
               "Comma-separated smoothing scales solved first, each starting the next, before "
               "--smoothing_scale (e.g. 0.2,0.1); empty: one solve.");
@@ -328,6 +338,11 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   request.truth = FLAGS_truth;
   request.exposure_s = FLAGS_exposure_s;
   request.fps = FLAGS_fps;
+  if (!ParseFrameTime(FLAGS_frame_time, &request.frame_time, &request.frame_lag_s)) {
+    throw InvalidArgumentError(
+        "--frame_time: expected instant, auto, start, middle, end or a lag in ms, got '" +
+        FLAGS_frame_time + "'");
+  }
 
   request.binning = BinningFromFlags();
 
@@ -358,6 +373,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   options.activity_radius_px = FLAGS_activity_radius_px;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
   options.split_independent_parts = FLAGS_split_independent_parts;
+  options.max_problem_mb = FLAGS_max_problem_mb;
   options.smoothing_continuation =
       ParseNumberList(FLAGS_smoothing_continuation, "--smoothing_continuation");
 

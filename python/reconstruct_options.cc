@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/time.h"
 #include "scene/event_model.h"
+#include "scene/frame_timing.h"
 #include "scene/scene.h"
 
 namespace evfs {
@@ -115,6 +116,18 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       // Data and output.
       DoubleOption<R>("exposure_s", [](R& s) -> double& { return s.request.exposure_s; }),
       DoubleOption<R>("fps", [](R& s) -> double& { return s.request.fps; }),
+      {"frame_time",
+       [](const R& s) {
+         return py::cast(FrameTimeName(s.request.frame_time, s.request.frame_lag_s));
+       },
+       [](py::handle v, R* s) {
+         if (!ParseFrameTime(ToString("frame_time", v), &s->request.frame_time,
+                             &s->request.frame_lag_s)) {
+           throw InvalidArgumentError(
+               "--frame_time: expected instant, auto, start, middle, end "
+               "or a lag in ms");
+         }
+       }},
       // Method.
       {"solver",
        [](const R& s) { return py::cast(std::string(MethodName(s.request.method.method))); },
@@ -182,6 +195,7 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       BoolOption<R>("merge_quiet_steps", [](R& s) -> bool& { return Rec(s).merge_quiet_steps; }),
       BoolOption<R>("split_independent_parts",
                     [](R& s) -> bool& { return Rec(s).split_independent_parts; }),
+      IntOption<R>("max_problem_mb", [](R& s) -> int64_t& { return Rec(s).max_problem_mb; }),
       // Ceres.
       {"linear_solver",
        [](const R& s) {

@@ -85,67 +85,185 @@ ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) 
   return *this;
 }
 
-// What every part of a scene shares: which pixels are solved for, how their time series are
-// cut into segments, and which terms the objective has. The mask is on the heap: `terms`
-// refers to it.
-struct ProblemBuilder::Prepared {
-  std::shared_ptr<const ActivityMask> mask;
-  std::shared_ptr<const LatentLayout> layout;
-  std::shared_ptr<const ObjectiveTerms> terms;
-};
-
 ProblemBuilder::ProblemBuilder(const Scene& scene, const ReconstructionOptions& options)
     : scene_(scene), options_(options) {}
 
-ProblemBuilder::Prepared ProblemBuilder::Prepare(Video* latent) const {
+ProblemPlan ProblemBuilder::Prepare(Video* latent) const {
   if (latent->num_frames() != scene_.num_latent_frames() || latent->height() != scene_.height ||
       latent->width() != scene_.width) {
     throw InvalidArgumentError("the latent video does not match the scene's size");
   }
-  Prepared prepared;
-  prepared.mask = std::make_shared<ActivityMask>(scene_.events, options_.activity_radius_px);
+  ProblemPlan prepared;
+  prepared.mask_ = std::make_shared<ActivityMask>(scene_.events, options_.activity_radius_px);
   auto layout =
-      std::make_shared<LatentLayout>(scene_, *prepared.mask, *latent, options_.merge_quiet_steps);
+      std::make_shared<LatentLayout>(scene_, *prepared.mask_, *latent, options_.merge_quiet_steps);
   layout->ProjectOnto(latent);
-  prepared.layout = std::move(layout);
-  prepared.terms = std::make_shared<ObjectiveTerms>(scene_, options_.objective, *prepared.mask);
+  prepared.layout_ = std::move(layout);
+  prepared.terms_ = std::make_shared<ObjectiveTerms>(scene_, options_.objective, *prepared.mask_);
   return prepared;
 }
 
 std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
-  const Prepared prepared = Prepare(latent);
-  std::vector<int64_t> pixels;
-  for (int64_t p = 0; p < prepared.mask->num_pixels(); ++p) {
-    if (prepared.mask->in_problem(p)) pixels.push_back(p);
+  const ProblemPlan prepared = Prepare(latent);
+  ProblemUnit unit;
+  for (int64_t p = 0; p < prepared.mask_->num_pixels(); ++p) {
+    if (prepared.mask_->in_problem(p)) unit.pixels.push_back(p);
   }
-  std::unique_ptr<BuiltProblem> built = BuildPart(prepared, pixels, latent);
-  built->statistics_.skipped_pixels = prepared.mask->num_pixels() - prepared.mask->num_active();
+  std::unique_ptr<BuiltProblem> built = BuildPart(prepared, unit, latent);
+  built->statistics_.skipped_pixels = prepared.mask_->num_pixels() - prepared.mask_->num_active();
   return built;
 }
 
 std::vector<std::unique_ptr<BuiltProblem>> ProblemBuilder::BuildParts(Video* latent,
                                                                       int build_workers) const {
-  const Prepared prepared = Prepare(latent);
-  const std::vector<std::vector<int64_t>> parts =
-      prepared.mask->IndependentParts(options_.min_part_pixels);
+  const ProblemPlan prepared = Prepare(latent);
+  std::vector<ProblemUnit> parts;
+  for (std::vector<int64_t>& pixels : prepared.mask_->IndependentParts(options_.min_part_pixels)) {
+    parts.emplace_back().pixels = std::move(pixels);
+  }
   std::vector<std::unique_ptr<BuiltProblem>> built(parts.size());
   ParallelForEach(static_cast<int>(parts.size()), build_workers,
                   [&](int i) { built[i] = BuildPart(prepared, parts[i], latent); });
   return built;
 }
 
-std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared,
-                                                        const std::vector<int64_t>& pixels,
+int64_t ProblemBuilder::EstimatedBytes(const ProblemPlan& prepared, int64_t p) const {
+  // A problem holds about 300 bytes per parameter block and 330 per residual block
+  // (ceres::Problem, its Program, the Jacobian and the CGNR workspace), fitted to the peak
+  // memory of solves from 1.4 M to 2.2 M parameter blocks (BENCHMARKS.md, "Memory bounded
+  // before allocation"). A pixel with s segments has up to s event and temporal TV residuals
+  // and about 3s spatial TV runs with its neighbours; an active one has a residual per frame.
+  constexpr int64_t kBytesPerParameterBlock = 300;
+  constexpr int64_t kBytesPerResidualBlock = 330;
+  const LatentLayout& layout = *prepared.layout_;
+  int64_t segments = 0;
+  for (int64_t s = layout.segment_at(0, p);
+       s >= 0 && s < layout.num_segments() && layout.segment(s).pixel == p; ++s) {
+    ++segments;
+  }
+  const int64_t frames = prepared.mask_->active(p) ? static_cast<int64_t>(scene_.frames.size()) : 0;
+  return kBytesPerParameterBlock * segments + kBytesPerResidualBlock * (frames + 5 * segments);
+}
+
+std::vector<ProblemUnit> ProblemBuilder::Bands(const ProblemPlan& prepared,
+                                               const std::vector<int64_t>& part,
+                                               int64_t max_bytes) const {
+  // Bands are solved top to bottom, each with the row above it held at the band before's
+  // answer and the row below at the initialisation. A band solves this many rows beyond its
+  // own below it, where that initial boundary pulls, and the next band solves them again with
+  // the band before's answer above. Measured in BENCHMARKS.md ("Memory bounded before
+  // allocation").
+  constexpr int kMarginRows = 8;
+  const int64_t width = scene_.width;
+  const int first_row = static_cast<int>(part.front() / width);
+  const int last_row = static_cast<int>(part.back() / width);
+  // bytes_before[r - first_row]: the estimate of the part's pixels in rows first_row .. r - 1.
+  std::vector<int64_t> bytes_before(last_row - first_row + 2, 0);
+  for (const int64_t p : part) {
+    bytes_before[p / width - first_row + 1] += EstimatedBytes(prepared, p);
+  }
+  for (size_t r = 1; r < bytes_before.size(); ++r) bytes_before[r] += bytes_before[r - 1];
+  const auto rows_bytes = [&](int begin, int end) {  // rows [begin, end), clamped to the part
+    begin = std::max(begin, first_row);
+    end = std::min(end, last_row + 1);
+    return bytes_before[end - first_row] - bytes_before[begin - first_row];
+  };
+  const auto pixels_of_rows = [&](int begin, int end) {  // the part's pixels in rows [begin, end)
+    const auto from = std::lower_bound(part.begin(), part.end(), int64_t{begin} * width);
+    const auto to = std::lower_bound(part.begin(), part.end(), int64_t{end} * width);
+    return std::vector<int64_t>(from, to);
+  };
+  std::vector<ProblemUnit> bands;
+  for (int core_begin = first_row; core_begin <= last_row;) {
+    int core_end = core_begin + 1;  // at least one row, whatever the budget
+    while (core_end <= last_row &&
+           rows_bytes(core_begin, core_end + 1 + kMarginRows) <= max_bytes) {
+      ++core_end;
+    }
+    ProblemUnit& band = bands.emplace_back();
+    band.band = true;
+    band.row_begin = core_begin;
+    band.row_end = std::min(last_row + 1, core_end + kMarginRows);
+    band.estimated_bytes = rows_bytes(band.row_begin, band.row_end);
+    // The rows next to the band, held constant, come with it.
+    band.pixels = pixels_of_rows(band.row_begin - 1, band.row_end + 1);
+    core_begin = core_end;
+  }
+  return bands;
+}
+
+ProblemPlan ProblemBuilder::Plan(Video* latent, int64_t max_bytes) const {
+  ProblemPlan plan = Prepare(latent);
+  const ActivityMask& mask = *plan.mask_;
+  std::vector<ProblemUnit> units;
+  if (options_.split_independent_parts) {
+    for (std::vector<int64_t>& pixels : mask.IndependentParts(options_.min_part_pixels)) {
+      units.emplace_back().pixels = std::move(pixels);
+    }
+  } else {
+    ProblemUnit& whole = units.emplace_back();
+    for (int64_t p = 0; p < mask.num_pixels(); ++p) {
+      if (mask.in_problem(p)) whole.pixels.push_back(p);
+    }
+    if (whole.pixels.empty()) units.clear();
+  }
+  for (ProblemUnit& unit : units) {
+    for (const int64_t p : unit.pixels) unit.estimated_bytes += EstimatedBytes(plan, p);
+    plan.estimated_bytes_ += unit.estimated_bytes;
+  }
+  if (max_bytes < 0 || plan.estimated_bytes_ <= max_bytes) {
+    plan.batches_.push_back(std::move(units));
+    return plan;
+  }
+  // Parts come largest first: those too large alone become bands, the others fill batches.
+  int64_t batch_bytes = 0;
+  bool packing = false;  // the last batch takes more parts
+  for (ProblemUnit& unit : units) {
+    if (unit.estimated_bytes > max_bytes) {
+      for (ProblemUnit& band : Bands(plan, unit.pixels, max_bytes)) {
+        plan.batches_.push_back({std::move(band)});
+      }
+      packing = false;
+      continue;
+    }
+    if (!packing || batch_bytes + unit.estimated_bytes > max_bytes) {
+      plan.batches_.emplace_back();
+      batch_bytes = 0;
+      packing = true;
+    }
+    batch_bytes += unit.estimated_bytes;
+    plan.batches_.back().push_back(std::move(unit));
+  }
+  return plan;
+}
+
+std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& plan,
+                                                        const ProblemUnit& unit,
+                                                        Video* latent) const {
+  return BuildPart(plan, unit, latent);
+}
+
+std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const ProblemPlan& prepared,
+                                                        const ProblemUnit& unit,
                                                         Video* latent) const {
   const ObjectiveOptions& objective = options_.objective;
-  const ActivityMask& mask = *prepared.mask;
-  const LatentLayout& layout = *prepared.layout;
-  const ObjectiveTerms& terms = *prepared.terms;
+  const ActivityMask& mask = *prepared.mask_;
+  const LatentLayout& layout = *prepared.layout_;
+  const ObjectiveTerms& terms = *prepared.terms_;
+  const std::vector<int64_t>& pixels = unit.pixels;
   const int num_latent = scene_.num_latent_frames();
   const int width = scene_.width;
 
+  // A band solves its own rows; the rows next to it are held constant.
+  const auto inside = [&](int64_t p) {
+    const int64_t row = p / width;
+    return !unit.band || (row >= unit.row_begin && row < unit.row_end);
+  };
+  // Terms of the pixels it solves: active ones, inside the unit.
+  const auto solved = [&](int64_t p) { return mask.active(p) && inside(p); };
+
   auto built = std::make_unique<BuiltProblem>();
-  built->layout_ = prepared.layout;
+  built->layout_ = prepared.layout_;
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -167,12 +285,12 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     }
   };
   for (const int64_t p : pixels) {
-    statistics.active_pixels += mask.active(p);
+    statistics.active_pixels += solved(p);
     for_each_segment(p, [&](int64_t s) {
       double* value = layout.value(s, latent);
       problem.AddParameterBlock(value, 1);
       ++statistics.parameter_blocks;
-      if (layout.segment(s).constant) {
+      if (layout.segment(s).constant || !inside(p)) {
         problem.SetParameterBlockConstant(value);
         return;
       }
@@ -196,7 +314,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kFrame), 1);
     for (const FrameObservation& frame : scene_.frames) {
       for (const int64_t p : pixels) {
-        if (!mask.active(p)) continue;
+        if (!solved(p)) continue;
         // The exposure's voxels, one block per run of a segment.
         blocks.clear();
         shape.clear();
@@ -225,7 +343,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
       const int steps = span.latent_last - span.latent_first;
       const float* values = scene_.events.frame_data(k);
       for (const int64_t p : pixels) {
-        if (!mask.active(p)) continue;
+        if (!solved(p)) continue;
         // Over merged steps H does not change and the model predicts 0: a step contributes
         // only where a segment starts. The layout starts one at every step of a frame that
         // fired, so a frame is either all new segments or (quiet, value 0) none, residual 0.
@@ -281,12 +399,14 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     // A term touches an active pixel (ObjectiveTerms), so the others it touches are in the
     // problem (within one pixel of an active one) and in the same part; it is built by the part
     // of its top-left pixel.
+    // A band builds only the terms that touch its own rows.
     for (const int64_t p : pixels) {
       const SpatialTvTermsAt owned = terms.spatial_tv_terms_at(p);
+      const bool here = inside(p), below = inside(p + width);
       if (anisotropic) {
-        if (owned.right) add_runs({p, p + 1});
-        if (owned.below) add_runs({p, p + width});
-      } else if (owned.right) {
+        if (owned.right && here) add_runs({p, p + 1});
+        if (owned.below && (here || below)) add_runs({p, p + width});
+      } else if (owned.right && (here || below)) {
         add_runs({p, p + 1, p + width});
       }
     }
@@ -298,6 +418,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     ceres::CostFunction* difference =
         cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
     for (const int64_t p : pixels) {
+      if (!inside(p)) continue;
       for_each_segment(p, [&](int64_t s) {
         if (layout.segment(s).constant || s + 1 >= layout.num_segments() ||
             layout.segment(s + 1).pixel != p) {
@@ -316,7 +437,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const Prepared& prepared
     const double weight = terms.weight(TermFamily::kPrior);
     const Video& target = *objective.prior_target;
     for (const int64_t p : pixels) {
-      if (!mask.active(p)) continue;
+      if (!solved(p)) continue;
       for_each_segment(p, [&](int64_t s) {
         const LatentLayout::Segment& segment = layout.segment(s);
         if (segment.constant) return;

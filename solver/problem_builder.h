@@ -11,8 +11,10 @@
 #include <vector>
 
 #include "core/video.h"
+#include "scene/activity_mask.h"
 #include "scene/scene.h"
 #include "solver/latent_layout.h"
+#include "solver/objective_terms.h"
 #include "solver/reconstruction_options.h"
 
 namespace evfs {
@@ -27,9 +29,11 @@ struct ProblemStatistics {
   int64_t temporal_tv_residuals = 0;
   int64_t prior_residuals = 0;  // the quadratic prior (plug & play), one per unknown
   int64_t distinct_cost_functions = 0;
-  int64_t active_pixels = 0;   // pixels whose time series is solved for
-  int64_t skipped_pixels = 0;  // pixels left at their initial value (ActivityMask)
-  int64_t parts = 1;           // independent problems (ActivityMask::IndependentParts)
+  int64_t active_pixels = 0;    // pixels whose time series is solved for
+  int64_t skipped_pixels = 0;   // pixels left at their initial value (ActivityMask)
+  int64_t parts = 1;            // problems built: independent parts, or bands of one
+  int64_t batches = 1;          // groups of parts built and solved at once (ProblemPlan)
+  int64_t estimated_bytes = 0;  // the plan's estimate for every part at once (not summed)
 
   int64_t residual_blocks() const {
     return frame_residuals + event_residuals + spatial_tv_residuals + temporal_tv_residuals +
@@ -59,6 +63,40 @@ class BuiltProblem {
   ProblemStatistics statistics_;
 };
 
+/// A set of pixels solved as one Ceres problem. A whole part (ActivityMask::IndependentParts)
+/// couples to nothing outside it; a band of a part too large for the memory budget solves the
+/// part's pixels in rows [row_begin, row_end) and holds the part's pixels in the rows next to it,
+/// which its spatial TV terms touch, constant at their current values.
+struct ProblemUnit {
+  std::vector<int64_t> pixels;  // ascending: the part's, or the band's with the row above it
+  bool band = false;
+  int row_begin = 0;
+  int row_end = 0;
+  /// Memory the unit's problem will hold while it is solved (ProblemBuilder::Plan).
+  int64_t estimated_bytes = 0;
+};
+
+/// Everything the units of one latent video share (activity mask, segment layout, terms), and
+/// the units grouped into batches: the units of a batch are disjoint and uncoupled, built and
+/// solved together; batches one after another, each within the memory budget.
+class ProblemPlan {
+ public:
+  const LatentLayout& layout() const { return *layout_; }
+  const std::vector<std::vector<ProblemUnit>>& batches() const { return batches_; }
+  /// The estimate for every unit at once (what one batch would hold without a budget).
+  int64_t estimated_bytes() const { return estimated_bytes_; }
+  /// Pixels whose time series are solved for.
+  int64_t active_pixels() const { return mask_->num_active(); }
+
+ private:
+  friend class ProblemBuilder;
+  std::shared_ptr<const ActivityMask> mask_;
+  std::shared_ptr<const LatentLayout> layout_;
+  std::shared_ptr<const ObjectiveTerms> terms_;
+  std::vector<std::vector<ProblemUnit>> batches_;
+  int64_t estimated_bytes_ = 0;
+};
+
 /// Parameter layout: one scalar parameter block per segment of the LatentLayout (per voxel
 /// H_t(p) when quiet steps are not merged), pointing into the latent Video, and one scalar
 /// residual block per term. A prototype on this machine compared it with
@@ -81,11 +119,27 @@ class ProblemBuilder {
   /// `build_workers` threads build them.
   std::vector<std::unique_ptr<BuiltProblem>> BuildParts(Video* latent, int build_workers) const;
 
+  /// Plans a solve whose problems hold at most `max_bytes` at once (estimated from the layout's
+  /// segment counts before anything is built; < 0: no limit). The units are the independent
+  /// parts when options.split_independent_parts holds, else one; when they all fit, the plan
+  /// is one batch of them (BuildParts()), otherwise parts are packed into batches that fit and a
+  /// part that does not fit alone is cut into overlapping bands of rows, one batch each. Each
+  /// segment of the layout starts at the mean of its voxels in `latent`, which must outlive
+  /// the plan and the problems built from it.
+  ProblemPlan Plan(Video* latent, int64_t max_bytes) const;
+  /// The problem of one unit of `plan` over `latent` (the video Plan() was given).
+  std::unique_ptr<BuiltProblem> BuildUnit(const ProblemPlan& plan, const ProblemUnit& unit,
+                                          Video* latent) const;
+
  private:
-  struct Prepared;
-  Prepared Prepare(Video* latent) const;
-  std::unique_ptr<BuiltProblem> BuildPart(const Prepared& prepared,
-                                          const std::vector<int64_t>& pixels, Video* latent) const;
+  ProblemPlan Prepare(Video* latent) const;
+  std::unique_ptr<BuiltProblem> BuildPart(const ProblemPlan& prepared, const ProblemUnit& unit,
+                                          Video* latent) const;
+  // The bytes a problem holding pixel p's segments and terms needs (Plan()).
+  int64_t EstimatedBytes(const ProblemPlan& prepared, int64_t p) const;
+  // Cuts `part` into overlapping bands of rows of at most `max_bytes` each.
+  std::vector<ProblemUnit> Bands(const ProblemPlan& prepared, const std::vector<int64_t>& part,
+                                 int64_t max_bytes) const;
 
   const Scene& scene_;
   const ReconstructionOptions& options_;

@@ -81,7 +81,10 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
     check.Check(scale > 0.0 && std::isfinite(scale),
                 "every smoothing_continuation scale must be positive and finite");
   }
-  check.Check(min_part_pixels >= 1, "min_part_pixels must be at least 1").Valid(solver);
+  check.Check(min_part_pixels >= 1, "min_part_pixels must be at least 1")
+      .Check(max_problem_mb <= kMaxProblemMb,
+             "max_problem_mb must be at most " + std::to_string(kMaxProblemMb) + " (1 TiB)")
+      .Valid(solver);
   return check.Passed(error);
 }
 

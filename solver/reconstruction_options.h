@@ -96,6 +96,16 @@ struct ReconstructionOptions {
   /// would otherwise pay thousands of times.
   int64_t min_part_pixels = 1024;
 
+  /// Most memory (MiB) the Ceres problems of a solve hold at once, estimated from the layout
+  /// before anything is built (ProblemBuilder::Plan): parts are then built and solved in
+  /// batches that fit, and a part too large alone in overlapping bands of rows, one after
+  /// another. The recording, scene, latent video and layout come on top (about 560 MB for 2 M
+  /// events at 640x480, where the default keeps the whole process under 1 GB; BENCHMARKS.md,
+  /// "Memory bounded before allocation"). <= 0: no limit. The first-order solvers (adam,
+  /// L-BFGS) build no Ceres problem and ignore it.
+  int64_t max_problem_mb = 384;
+  static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;
+
   /// Ceres settings, all of them available to library users; the defaults below are set by
   /// DefaultSolverOptions() (Levenberg–Marquardt, CGNR with a Jacobi preconditioner).
   ceres::Solver::Options solver;

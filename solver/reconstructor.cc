@@ -127,78 +127,102 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   const int threads = std::max(1, solve_options.solver.num_threads);
   const auto build_start = Clock::now();
   const ProblemBuilder builder(scene, solve_options);
-  std::vector<std::unique_ptr<BuiltProblem>> parts;
-  if (solve_options.split_independent_parts) {
-    parts = builder.BuildParts(&result->video, threads);
-  } else {
-    parts.push_back(builder.Build(&result->video));
-  }
+  const int64_t max_bytes = solve_options.max_problem_mb > 0
+                                ? solve_options.max_problem_mb * (int64_t{1} << 20)
+                                : int64_t{-1};
+  const ProblemPlan plan = builder.Plan(&result->video, max_bytes);
   summary.build_time_s += SecondsSince(build_start);
   summary.problem = ProblemStatistics();
   summary.problem.parts = 0;
-  for (const auto& part : parts) summary.problem += part->statistics();
-  summary.problem.skipped_pixels =
-      static_cast<int64_t>(scene.height) * scene.width - summary.problem.active_pixels;
-  if (summary.problem.variable_parameter_blocks == 0) {
+  summary.problem.batches = static_cast<int64_t>(plan.batches().size());
+  summary.problem.estimated_bytes = plan.estimated_bytes();
+  summary.problem.skipped_pixels = static_cast<int64_t>(scene.height) * scene.width;
+
+  std::unique_ptr<CallbackAdapter> adapter;
+  if (callback)
+    adapter = std::make_unique<CallbackAdapter>(callback, plan.layout(), &result->video);
+  double done_cost = 0.0;  // final cost of the batches solved so far
+  int iterations = 0;      // of the unit that took most
+  bool first_unit = true;
+  bool any_unknowns = false;
+  for (const std::vector<ProblemUnit>& batch : plan.batches()) {
+    if (adapter && adapter->stopped()) break;
+    const auto batch_build_start = Clock::now();
+    std::vector<std::unique_ptr<BuiltProblem>> parts(batch.size());
+    ParallelForEach(static_cast<int>(batch.size()), threads,
+                    [&](int i) { parts[i] = builder.BuildUnit(plan, batch[i], &result->video); });
+    summary.build_time_s += SecondsSince(batch_build_start);
+    for (const auto& part : parts) {
+      summary.problem += part->statistics();
+      any_unknowns = any_unknowns || part->statistics().variable_parameter_blocks > 0;
+    }
+
+    std::vector<ceres::Solver::Summary> part_summaries(parts.size());
+    const auto solve_start = Clock::now();
+    // Ceres stops when an iteration changes the cost by less than function_tolerance times the
+    // cost. A part is held to the same absolute change as its whole batch would be: its
+    // tolerance is scaled by the batch's initial cost over its own, so that a small region
+    // stops once its progress no longer matters to the objective instead of iterating on its
+    // own noise.
+    std::vector<double> costs(parts.size(), 0.0);
+    if (parts.size() > 1 || (adapter && plan.batches().size() > 1)) {
+      ParallelForEach(static_cast<int>(parts.size()), threads,
+                      [&](int i) { costs[i] = InitialCost(&parts[i]->problem()); });
+    }
+    double batch_cost = 0.0;
+    for (const double cost : costs) batch_cost += cost;
+    const auto part_options = [&](size_t i, int part_threads) {
+      ceres::Solver::Options part = solve_options.solver;
+      part.num_threads = part_threads;
+      if (parts.size() > 1 && costs[i] > 0.0) part.function_tolerance *= batch_cost / costs[i];
+      return part;
+    };
+    double time_in_callback_s = 0.0;
+    if (adapter) {
+      // One after another, each with every thread, so that the callback sees a whole video.
+      // It reports the batches solved so far at their final cost, this one's parts not yet
+      // solved at their initial one; batches to come are not built yet and not counted.
+      const double callback_time_before = adapter->time_in_callback_s();
+      double current_total = done_cost + batch_cost;
+      for (size_t i = 0; i < parts.size() && !adapter->stopped(); ++i) {
+        adapter->StartPart(current_total - costs[i], first_unit);
+        first_unit = false;
+        ceres::Solver::Options options_i = part_options(i, threads);
+        options_i.callbacks.push_back(adapter.get());
+        options_i.update_state_every_iteration = true;
+        ceres::Solve(options_i, &parts[i]->problem(), &part_summaries[i]);
+        current_total += part_summaries[i].final_cost - costs[i];
+        costs[i] = part_summaries[i].final_cost;
+      }
+      time_in_callback_s = adapter->time_in_callback_s() - callback_time_before;
+      // Parts left when the callback stopped the solve stay at their start.
+      for (size_t i = 0; i < parts.size(); ++i) {
+        if (!part_summaries[i].iterations.empty()) continue;
+        part_summaries[i].termination_type = ceres::USER_SUCCESS;
+        part_summaries[i].initial_cost = part_summaries[i].final_cost = costs[i];
+      }
+    } else {
+      // Largest first, each worker taking the next part as it becomes free; Ceres' own threads
+      // split what remains.
+      const int workers = std::min<int>(threads, static_cast<int>(parts.size()));
+      ParallelForEach(static_cast<int>(parts.size()), workers, [&](int i) {
+        ceres::Solve(part_options(i, std::max(1, threads / workers)), &parts[i]->problem(),
+                     &part_summaries[i]);
+      });
+    }
+    summary.solve_time_s += SecondsSince(solve_start) - time_in_callback_s;
+    for (size_t i = 0; i < parts.size(); ++i) {
+      Accumulate(part_summaries[i], &batch == &plan.batches().front() && i == 0, &summary.ceres);
+      done_cost += part_summaries[i].final_cost;
+      iterations = std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
+    }
+  }
+  // Bands overlap: a pixel is counted once.
+  summary.problem.active_pixels = plan.active_pixels();
+  summary.problem.skipped_pixels -= summary.problem.active_pixels;
+  if (!any_unknowns) {
     summary.skipped_reason = "no unknowns: no pixel is active";
     return;
-  }
-
-  std::vector<ceres::Solver::Summary> part_summaries(parts.size());
-  const auto solve_start = Clock::now();
-  // Ceres stops when an iteration changes the cost by less than function_tolerance times the
-  // cost. A part is held to the same absolute change as the whole problem would be: its
-  // tolerance is scaled by the whole initial cost over its own, so that a small region stops
-  // once its progress no longer matters to the objective instead of iterating on its own
-  // noise.
-  std::vector<double> costs(parts.size(), 0.0);
-  if (parts.size() > 1) {
-    ParallelForEach(static_cast<int>(parts.size()), threads,
-                    [&](int i) { costs[i] = InitialCost(&parts[i]->problem()); });
-  }
-  double total_cost = 0.0;
-  for (const double cost : costs) total_cost += cost;
-  const auto part_options = [&](size_t i, int part_threads) {
-    ceres::Solver::Options part = solve_options.solver;
-    part.num_threads = part_threads;
-    if (parts.size() > 1 && costs[i] > 0.0) part.function_tolerance *= total_cost / costs[i];
-    return part;
-  };
-  double time_in_callback_s = 0.0;
-  if (callback) {
-    // One after another, each with every thread, so that the callback sees a whole video.
-    CallbackAdapter adapter(callback, parts.front()->layout(), &result->video);
-    double current_total = total_cost;  // the parts done at their final cost, the rest initial
-    for (size_t i = 0; i < parts.size() && !adapter.stopped(); ++i) {
-      adapter.StartPart(current_total - costs[i], i == 0);
-      ceres::Solver::Options options_i = part_options(i, threads);
-      options_i.callbacks.push_back(&adapter);
-      options_i.update_state_every_iteration = true;
-      ceres::Solve(options_i, &parts[i]->problem(), &part_summaries[i]);
-      current_total += part_summaries[i].final_cost - costs[i];
-      costs[i] = part_summaries[i].final_cost;
-    }
-    time_in_callback_s = adapter.time_in_callback_s();
-    // Parts left when the callback stopped the solve stay at their start.
-    for (size_t i = 0; i < parts.size(); ++i) {
-      if (!part_summaries[i].iterations.empty()) continue;
-      part_summaries[i].termination_type = ceres::USER_SUCCESS;
-      part_summaries[i].initial_cost = part_summaries[i].final_cost = costs[i];
-    }
-  } else {
-    // Largest first, each worker taking the next part as it becomes free; Ceres' own threads
-    // split what remains.
-    const int workers = std::min<int>(threads, static_cast<int>(parts.size()));
-    ParallelForEach(static_cast<int>(parts.size()), workers, [&](int i) {
-      ceres::Solve(part_options(i, std::max(1, threads / workers)), &parts[i]->problem(),
-                   &part_summaries[i]);
-    });
-  }
-  summary.solve_time_s += SecondsSince(solve_start) - time_in_callback_s;
-  int iterations = 0;  // of the part that took most
-  for (size_t i = 0; i < parts.size(); ++i) {
-    Accumulate(part_summaries[i], i == 0, &summary.ceres);
-    iterations = std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
   }
   summary.iterations += iterations;
   if (summary.ceres.termination_type == ceres::FAILURE) {
@@ -207,7 +231,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   summary.solved = true;
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
-  parts.front()->layout().Expand(&result->video);
+  plan.layout().Expand(&result->video);
 }
 
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,

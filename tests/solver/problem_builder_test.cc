@@ -295,5 +295,57 @@ TEST(ProblemBuilder, InitialisationBlendsLinearlyInTime) {
   EXPECT_EQ(latent.timestamp_ns(2), 20);
 }
 
+// With a budget below the whole problem's estimate, an all-active scene (one part) is cut into
+// bands of rows that cover every row, each estimated within the budget; a band's unknowns are
+// its own rows', and the rows next to it are in its problem held constant.
+TEST(ProblemBuilder, BandsCoverEveryRowWithinTheBudget) {
+  const Scene scene = MakeSceneWithEvents(40, 18, {{0, 2, 2}, {1, 20, 5}, {2, 37, 14}});
+  for (const SpatialTv tv : {SpatialTv::kAnisotropic, SpatialTv::kPaper}) {
+    SCOPED_TRACE(SpatialTvName(tv));
+    ReconstructionOptions options;
+    options.objective.event_model.alpha = 5.0;
+    options.objective.spatial_tv = tv;
+    options.activity_radius_px = -1;
+    Video latent = InitializeLatentVideo(scene);
+    const ProblemBuilder builder(scene, options);
+    const ProblemPlan whole = builder.Plan(&latent, -1);
+    ASSERT_EQ(whole.batches().size(), 1u);
+    ASSERT_EQ(whole.batches()[0].size(), 1u);
+    EXPECT_FALSE(whole.batches()[0][0].band);
+    const int64_t budget = whole.estimated_bytes() / 3;
+    const ProblemPlan plan = builder.Plan(&latent, budget);
+    ASSERT_GE(plan.batches().size(), 3u);
+    int next_row = 0;  // every row is solved by some band, in order
+    for (const std::vector<ProblemUnit>& batch : plan.batches()) {
+      ASSERT_EQ(batch.size(), 1u);
+      const ProblemUnit& band = batch[0];
+      EXPECT_TRUE(band.band);
+      EXPECT_LE(band.row_begin, next_row);
+      EXPECT_GT(band.row_end, next_row);
+      next_row = band.row_end;
+      EXPECT_LE(band.estimated_bytes, budget);
+      const auto built = builder.BuildUnit(plan, band, &latent);
+      ceres::Problem& problem = built->problem();
+      std::vector<double*> blocks;
+      problem.GetParameterBlocks(&blocks);
+      for (double* block : blocks) {
+        int row = -1;
+        for (int t = 0; t < latent.num_frames(); ++t) {
+          const int64_t p = block - latent.frame_data(t);
+          if (p >= 0 && p < int64_t{scene.height} * scene.width) row = p / scene.width;
+        }
+        ASSERT_GE(row, 0);
+        const bool own = row >= band.row_begin && row < band.row_end;
+        EXPECT_EQ(problem.IsParameterBlockConstant(block), !own) << "row " << row;
+        EXPECT_GE(row, band.row_begin - 1);
+        EXPECT_LE(row, band.row_end);
+      }
+      EXPECT_EQ(built->statistics().active_pixels,
+                static_cast<int64_t>(band.row_end - band.row_begin) * scene.width);
+    }
+    EXPECT_EQ(next_row, scene.height);
+  }
+}
+
 }  // namespace
 }  // namespace evfs

@@ -228,5 +228,56 @@ TEST(Reconstructor, LargePriorWeightPinsTheSolvedVoxelsToTheTarget) {
   EXPECT_LT(max_distance(pinned.video), kPinnedTolerance);
 }
 
+// A budget below the problem's estimate: one part, all active, solved in overlapping bands of
+// rows one after another. The answer stays that of the one problem.
+TEST(Reconstructor, BandsWithinAMemoryBudgetReachTheWholeProblemsAccuracy) {
+  const test::SyntheticRecording recording(/*width=*/64, /*height=*/96);
+  const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                             recording.events, BinningOptions());
+  ReconstructionOptions options;
+  options.activity_radius_px = -1;  // one part of every pixel
+  const Reconstruction whole = Reconstruct(scene, options);
+  ASSERT_EQ(whole.summary.problem.batches, 1);
+  const double estimated_mb =
+      static_cast<double>(whole.summary.problem.estimated_bytes) / (1 << 20);
+  options.max_problem_mb = static_cast<int64_t>(estimated_mb / 3);
+  ASSERT_GE(options.max_problem_mb, 1) << "the scene is too small to cut into bands";
+  const Reconstruction bands = Reconstruct(scene, options);
+  EXPECT_GE(bands.summary.problem.batches, 3);
+  EXPECT_EQ(bands.summary.problem.parts, bands.summary.problem.batches);
+  EXPECT_EQ(bands.summary.problem.active_pixels, whole.summary.problem.active_pixels);
+  EXPECT_EQ(bands.summary.problem.skipped_pixels, 0);
+  const double whole_psnr = PsnrAt(whole.video, recording, 10);
+  const double bands_psnr = PsnrAt(bands.video, recording, 10);
+  std::printf("estimate %.1f MB; one problem %.2f dB; %lld bands within %lld MB: %.2f dB\n",
+              estimated_mb, whole_psnr, static_cast<long long>(bands.summary.problem.batches),
+              static_cast<long long>(options.max_problem_mb), bands_psnr);
+  EXPECT_NEAR(bands_psnr, whole_psnr, 0.1);
+}
+
+// Parts that fit together are one batch; when they do not, batches take them one after another.
+TEST(Reconstructor, PartsBeyondTheBudgetAreSolvedInBatches) {
+  const test::SyntheticRecording recording(/*width=*/120, /*height=*/40);
+  const Scene scene = TwoRegionScene(recording);
+  ReconstructionOptions options = EveryRegionAPart();
+  const Reconstruction together = Reconstruct(scene, options);
+  ASSERT_GE(together.summary.problem.parts, 2);
+  EXPECT_EQ(together.summary.problem.batches, 1);
+  options.max_problem_mb = 1;
+  const Reconstruction batched = Reconstruct(scene, options);
+  EXPECT_GE(batched.summary.problem.batches, 2);
+  EXPECT_NEAR(PsnrAt(batched.video, recording, 10), PsnrAt(together.video, recording, 10), 0.1);
+}
+
+TEST(Reconstructor, MemoryBudgetBeyondOneTebibyteIsRefused) {
+  ReconstructionOptions options;
+  options.max_problem_mb = ReconstructionOptions::kMaxProblemMb + 1;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("max_problem_mb"), std::string::npos) << error;
+  options.max_problem_mb = 0;  // no limit
+  EXPECT_TRUE(options.IsValid(nullptr));
+}
+
 }  // namespace
 }  // namespace evfs
