@@ -89,6 +89,7 @@ ProgramHelp MakeEvfsHelp() {
       {"merge_quiet_steps", "model", "reconstruct video"},
       {"split_independent_parts", "model", "reconstruct video"},
       {"max_problem_mb", "model", "reconstruct video"},
+      {"blend_quiet_pixels", "model", "reconstruct video"},
       // Ceres.
       {"linear_solver", "solver", "reconstruct video"},
       {"preconditioner", "solver", "reconstruct video"},

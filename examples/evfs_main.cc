@@ -155,6 +155,9 @@ DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "Solve the regions that no term couples as separate problems, concurrently "
             "(one after another with --progress or --checkpoints); false: one problem.");
+DEFINE_bool(blend_quiet_pixels, evfs::ReconstructionOptions().blend_quiet_pixels,
+            "After the solve, pixels no event fired whose sharp frames differ by less than one "
+            "event's change take the time-weighted blend of the frames between them.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once, estimated before building: "
              "larger problems are solved in batches of parts, or in overlapping bands of rows, "
@@ -374,6 +377,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
   options.split_independent_parts = FLAGS_split_independent_parts;
   options.max_problem_mb = FLAGS_max_problem_mb;
+  options.blend_quiet_pixels = FLAGS_blend_quiet_pixels;
   options.smoothing_continuation =
       ParseNumberList(FLAGS_smoothing_continuation, "--smoothing_continuation");
 

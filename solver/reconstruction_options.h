@@ -104,6 +104,13 @@ struct ReconstructionOptions {
   /// "Memory bounded before allocation"). <= 0: no limit. The first-order solvers (adam,
   /// L-BFGS) build no Ceres problem and ignore it.
   int64_t max_problem_mb = 384;
+
+  /// After the solve, a pixel that no event fired and whose consecutive sharp frames differ by
+  /// less than one event's change (in the event model's g) takes the time-weighted blend of
+  /// the two between them: no event says its change stayed below the threshold, and the blend
+  /// meets both frames, where the solve holds such a pixel constant at a value the ℓ1 frame
+  /// terms leave undecided. Off by default: BENCHMARKS.md, "Quiet scenes".
+  bool blend_quiet_pixels = false;
   static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;
 
   /// Ceres settings, all of them available to library users; the defaults below are set by

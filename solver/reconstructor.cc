@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -101,6 +103,41 @@ double InitialCost(ceres::Problem* problem) {
   return cost;
 }
 
+// ReconstructionOptions::blend_quiet_pixels.
+void BlendQuietPixels(const Scene& scene, const EventModelParams& event_model,
+                      double change_per_event, Video* latent) {
+  std::vector<const FrameObservation*> sharp;
+  for (const FrameObservation& frame : scene.frames) {
+    if (frame.latent_first == frame.latent_last) sharp.push_back(&frame);
+  }
+  std::sort(sharp.begin(), sharp.end(),
+            [](const auto* a, const auto* b) { return a->latent_first < b->latent_first; });
+  const int64_t pixels = latent->pixels_per_frame();
+  std::vector<uint8_t> fired(pixels, 0);
+  for (int k = 0; k < scene.events.num_frames(); ++k) {
+    const float* values = scene.events.frame_data(k);
+    for (int64_t p = 0; p < pixels; ++p) fired[p] |= values[p] != 0.0f;
+  }
+  const std::vector<int64_t>& times = scene.latent_timestamps_ns();
+  for (size_t j = 0; j + 1 < sharp.size(); ++j) {
+    const int a = sharp[j]->latent_first, b = sharp[j + 1]->latent_first;
+    const double* first = sharp[j]->image.data();
+    const double* last = sharp[j + 1]->image.data();
+    for (int64_t p = 0; p < pixels; ++p) {
+      if (fired[p] || std::abs(IntensityTransform(last[p], event_model) -
+                               IntensityTransform(first[p], event_model)) >= change_per_event) {
+        continue;
+      }
+      for (int t = a; t <= b; ++t) {
+        const double w = times[b] > times[a]
+                             ? static_cast<double>(times[t] - times[a]) / (times[b] - times[a])
+                             : 0.0;
+        latent->frame_data(t)[p] = (1.0 - w) * first[p] + w * last[p];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOptions& options,
@@ -114,6 +151,8 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
   } else {
     *model = EventModelEstimate();
     model->alpha = event_model.alpha;
+    // The change an event stands for when α was derived from it (EstimateEventModel).
+    model->change_per_event = options.estimation.alpha_times_change / event_model.alpha;
     model->description = "alpha " + std::to_string(event_model.alpha) + " (given)";
   }
   return objective;
@@ -266,6 +305,10 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     stage.objective.smoothing_scale = scale;
     BuildAndSolve(scene, stage, callback, &result);
     if (!summary.solved) break;  // nothing to solve
+  }
+  if (options.blend_quiet_pixels && summary.solved) {
+    BlendQuietPixels(scene, solve_options.objective.event_model, summary.model.change_per_event,
+                     &result.video);
   }
   return result;
 }

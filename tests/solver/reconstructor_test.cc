@@ -11,6 +11,7 @@
 #include "core/metrics.h"
 #include "scene/activity_mask.h"
 #include "tests/scene/scene_test_scenes.h"
+#include "tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {
@@ -277,6 +278,29 @@ TEST(Reconstructor, MemoryBudgetBeyondOneTebibyteIsRefused) {
   EXPECT_NE(error.find("max_problem_mb"), std::string::npos) << error;
   options.max_problem_mb = 0;  // no limit
   EXPECT_TRUE(options.IsValid(nullptr));
+}
+
+// A pixel no event fired, whose frames differ by less than one event's change, takes the blend
+// of the frames; a pixel that fired, and one whose frames differ by more, keep the solve's answer.
+TEST(Reconstructor, QuietPixelsTakeTheBlendOfTheFrames) {
+  Scene scene = MakeSceneWithEvents(6, 8, {{0, 2, 2}, {1, 2, 3}, {2, 3, 3}});
+  scene.frames[0].image = Image::Constant(6, 8, 0.40);
+  scene.frames[1].image = Image::Constant(6, 8, 0.42);
+  scene.frames[1].image(3, 5) = 0.9;  // unfired, but a change of many events
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  options.activity_radius_px = -1;
+  const Reconstruction solved = Reconstruct(scene, options);
+  options.blend_quiet_pixels = true;
+  const Reconstruction blended = Reconstruct(scene, options);
+  ASSERT_TRUE(blended.summary.solved);
+  const auto& times = scene.latent_timestamps_ns();
+  for (int t = 0; t < scene.num_latent_frames(); ++t) {
+    const double w = static_cast<double>(times[t] - times[0]) / (times.back() - times[0]);
+    EXPECT_NEAR(blended.video.frame(t)(0, 0), (1.0 - w) * 0.40 + w * 0.42, 1e-12) << t;
+    EXPECT_EQ(blended.video.frame(t)(2, 2), solved.video.frame(t)(2, 2)) << t;
+    EXPECT_EQ(blended.video.frame(t)(3, 5), solved.video.frame(t)(3, 5)) << t;
+  }
 }
 
 }  // namespace
