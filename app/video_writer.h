@@ -1,16 +1,13 @@
 // Encoding frame sequences as MP4 files through OpenCV's VideoWriter (the FFmpeg back end of
-// Debian's OpenCV), for `evfs video`.
+// Debian's OpenCV), for `evfs video`. The encoder lives in a plug-in opened on first use
+// (app/mp4_encoder_plugin.h), so that the other commands do not load videoio.
 #ifndef EVFS_APP_VIDEO_WRITER_H_
 #define EVFS_APP_VIDEO_WRITER_H_
 
-#include <memory>
 #include <string>
+#include <vector>
 
 #include "core/video.h"
-
-namespace cv {
-class VideoWriter;
-}
 
 namespace evfs {
 
@@ -22,7 +19,8 @@ extern const char* const kMp4Codecs[2];
 class Mp4Writer {
  public:
   /// Opens `path` for `width` × `height` colour frames at `fps` with the first codec of
-  /// kMp4Codecs that the FFmpeg back end accepts. Throws InputError(kUnwritable) when none does.
+  /// kMp4Codecs that the FFmpeg back end accepts. Throws InputError(kUnwritable) when none does,
+  /// and Error when the encoder plug-in (an incomplete installation) cannot be loaded.
   Mp4Writer(const std::string& path, double fps, int width, int height);
   ~Mp4Writer();
   Mp4Writer(const Mp4Writer&) = delete;
@@ -42,7 +40,8 @@ class Mp4Writer {
   std::string path_;
   int width_, height_;
   std::string codec_;
-  std::unique_ptr<cv::VideoWriter> writer_;
+  void* encoder_ = nullptr;         // the plug-in's, until Close()
+  std::vector<unsigned char> bgr_;  // WriteGrey's frame
 };
 
 }  // namespace evfs
