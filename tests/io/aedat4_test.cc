@@ -611,7 +611,9 @@ Recording MakeRecording(int width, int height, int num_events, uint32_t seed) {
 class Aedat4RoundTripTest : public ::testing::TestWithParam<Aedat4Compression> {};
 
 TEST_P(Aedat4RoundTripTest, ReadsBackWhatWasWritten) {
-  const std::string path = ScratchDir("aedat4_round_trip") + "/recording.aedat4";
+  const std::string path =
+      ScratchDir("aedat4_round_trip_" + std::to_string(static_cast<int>(GetParam()))) +
+      "/recording.aedat4";
   const Recording recording = MakeRecording(64, 48, 5000, 7);
   Aedat4WriteOptions options;
   options.compression = GetParam();
@@ -652,7 +654,9 @@ TEST_P(Aedat4RoundTripTest, ReadsBackWhatWasWritten) {
 
 TEST_P(Aedat4RoundTripTest, IndependentDecoderReadsTheWriterOutput) {
   EVFS_REQUIRE_REFERENCE_PYTHON(python);
-  const std::string path = ScratchDir("aedat4_independent") + "/recording.aedat4";
+  const std::string path =
+      ScratchDir("aedat4_independent_" + std::to_string(static_cast<int>(GetParam()))) +
+      "/recording.aedat4";
   const Recording recording = MakeRecording(32, 24, 2000, 11);
   Aedat4WriteOptions options;
   options.compression = GetParam();
