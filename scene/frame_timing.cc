@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/option_checker.h"
 #include "core/time.h"
+#include "scene/event_model.h"
 
 namespace evfs {
 namespace {
@@ -21,6 +22,9 @@ struct PreparedPair {
 };
 
 PreparedPair Prepare(const FramePair& pair, double log_offset) {
+  EventModelParams log_model;
+  log_model.model = EventModel::kLog;
+  log_model.log_offset = log_offset;
   PreparedPair prepared;
   prepared.first_t_ns = pair.first_t_ns;
   prepared.second_t_ns = pair.second_t_ns;
@@ -28,9 +32,8 @@ PreparedPair Prepare(const FramePair& pair, double log_offset) {
   prepared.centred_change.resize(static_cast<size_t>(n));
   double mean = 0.0;
   for (Eigen::Index p = 0; p < n; ++p) {
-    const double change =
-        std::log(std::max(0.0, static_cast<double>(pair.second->data()[p])) + log_offset) -
-        std::log(std::max(0.0, static_cast<double>(pair.first->data()[p])) + log_offset);
+    const double change = IntensityTransform(pair.second->data()[p], log_model) -
+                          IntensityTransform(pair.first->data()[p], log_model);
     prepared.centred_change[static_cast<size_t>(p)] = change;
     mean += change;
   }

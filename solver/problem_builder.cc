@@ -109,7 +109,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::Build(Video* latent) const {
   for (int64_t p = 0; p < prepared.mask_->num_pixels(); ++p) {
     if (prepared.mask_->in_problem(p)) unit.pixels.push_back(p);
   }
-  std::unique_ptr<BuiltProblem> built = BuildPart(prepared, unit, latent);
+  std::unique_ptr<BuiltProblem> built = BuildUnit(prepared, unit, latent);
   built->statistics_.skipped_pixels = prepared.mask_->num_pixels() - prepared.mask_->num_active();
   return built;
 }
@@ -123,7 +123,7 @@ std::vector<std::unique_ptr<BuiltProblem>> ProblemBuilder::BuildParts(Video* lat
   }
   std::vector<std::unique_ptr<BuiltProblem>> built(parts.size());
   ParallelForEach(static_cast<int>(parts.size()), build_workers,
-                  [&](int i) { built[i] = BuildPart(prepared, parts[i], latent); });
+                  [&](int i) { built[i] = BuildUnit(prepared, parts[i], latent); });
   return built;
 }
 
@@ -237,13 +237,7 @@ ProblemPlan ProblemBuilder::Plan(Video* latent, int64_t max_bytes) const {
   return plan;
 }
 
-std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& plan,
-                                                        const ProblemUnit& unit,
-                                                        Video* latent) const {
-  return BuildPart(plan, unit, latent);
-}
-
-std::unique_ptr<BuiltProblem> ProblemBuilder::BuildPart(const ProblemPlan& prepared,
+std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepared,
                                                         const ProblemUnit& unit,
                                                         Video* latent) const {
   const ObjectiveOptions& objective = options_.objective;

@@ -68,7 +68,7 @@ class BuiltProblem {
 /// part's pixels in rows [row_begin, row_end) and holds the part's pixels in the rows next to it,
 /// which its spatial TV terms touch, constant at their current values.
 struct ProblemUnit {
-  std::vector<int64_t> pixels;  // ascending: the part's, or the band's with the row above it
+  std::vector<int64_t> pixels;  // ascending: the part's, or the band's with the rows around it
   bool band = false;
   int row_begin = 0;
   int row_end = 0;
@@ -133,8 +133,6 @@ class ProblemBuilder {
 
  private:
   ProblemPlan Prepare(Video* latent) const;
-  std::unique_ptr<BuiltProblem> BuildPart(const ProblemPlan& prepared, const ProblemUnit& unit,
-                                          Video* latent) const;
   // The bytes a problem holding pixel p's segments and terms needs (Plan()).
   int64_t EstimatedBytes(const ProblemPlan& prepared, int64_t p) const;
   // Cuts `part` into overlapping bands of rows of at most `max_bytes` each.

@@ -123,16 +123,17 @@ void BlendQuietPixels(const Scene& scene, const EventModelParams& event_model,
     const int a = sharp[j]->latent_first, b = sharp[j + 1]->latent_first;
     const double* first = sharp[j]->image.data();
     const double* last = sharp[j + 1]->image.data();
+    std::vector<double> weight(b - a + 1, 0.0);  // of `last` at latent frame a + i
+    for (int t = a; t <= b && times[b] > times[a]; ++t) {
+      weight[t - a] = static_cast<double>(times[t] - times[a]) / (times[b] - times[a]);
+    }
     for (int64_t p = 0; p < pixels; ++p) {
       if (fired[p] || std::abs(IntensityTransform(last[p], event_model) -
                                IntensityTransform(first[p], event_model)) >= change_per_event) {
         continue;
       }
       for (int t = a; t <= b; ++t) {
-        const double w = times[b] > times[a]
-                             ? static_cast<double>(times[t] - times[a]) / (times[b] - times[a])
-                             : 0.0;
-        latent->frame_data(t)[p] = (1.0 - w) * first[p] + w * last[p];
+        latent->frame_data(t)[p] = (1.0 - weight[t - a]) * first[p] + weight[t - a] * last[p];
       }
     }
   }
