@@ -81,12 +81,11 @@ const char* const kMp4Codecs[2] = {"avc1", "mp4v"};
 Mp4Writer::Mp4Writer(const std::string& path, double fps, int width, int height)
     : path_(path), width_(width), height_(height) {
   const Mp4Plugin& plugin = LoadMp4Plugin();
-  // x264 with frame threads gave different bytes for the same frames from run to run of evfs
-  // (--jobs=1 against --jobs=2), so one encoder thread is asked for (OpenCV reads its FFmpeg
-  // writer options from this variable; a user's own setting wins). The bytes were still seen to
-  // differ between runs, so nothing relies on them: resumed and distributed runs are checked on
-  // frames/ and timestamps.txt (README, `evfs video`).
-  setenv("OPENCV_FFMPEG_WRITER_OPTIONS", "threads;1", /*overwrite=*/0);
+  // The same frames give the same bytes in every run (--jobs, --resume, MPI rank 0): the plug-in
+  // opens x264 on one CPU, since x264 picks its thread count, which changes the stream, from
+  // the CPUs it may use, and has glibc zero the memory it allocates, since x264 reads bytes it
+  // never wrote (app/mp4_encoder_plugin.cc). OPENCV_FFMPEG_WRITER_OPTIONS, set to "threads;1"
+  // here before, reaches no codec option in OpenCV 4.6, so it is left to the user.
   for (const char* codec : kMp4Codecs) {
     encoder_ = plugin.open(path.c_str(), codec, fps, width, height);
     if (encoder_ != nullptr) {

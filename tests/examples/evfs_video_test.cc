@@ -49,9 +49,13 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
-// frames/ and timestamps.txt of two outputs hold the same bytes.
+// frames/, timestamps.txt and video.mp4 of two outputs hold the same bytes (video.mp4 but under
+// AddressSanitizer, whose allocator the MP4 plug-in cannot have zero x264's buffers).
 void ExpectSameFrames(const fs::path& a, const fs::path& b) {
   EXPECT_EQ(ReadFile(a / "timestamps.txt"), ReadFile(b / "timestamps.txt"));
+#if !defined(__SANITIZE_ADDRESS__)
+  EXPECT_TRUE(ReadFile(a / "video.mp4") == ReadFile(b / "video.mp4"));
+#endif
   int count = 0;
   for (const auto& entry : fs::directory_iterator(a / "frames")) {
     const fs::path other = b / "frames" / entry.path().filename();
