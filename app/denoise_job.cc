@@ -164,6 +164,7 @@ DenoiseRecord PlugAndPlayLatentVideo(const Denoiser& denoiser, const Scene& scen
   }
   ReconstructionOptions options = method.reconstruction;
   options.objective.event_model.alpha = solved->reconstruction.model.alpha;
+  options.objective.event_model.saturation = solved->reconstruction.model.saturation;
   latent = PlugAndPlay(scene, options, denoiser, region, latent, pnp, &record.pnp, &record.stats);
   return record;
 }

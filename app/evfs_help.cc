@@ -80,6 +80,7 @@ ProgramHelp MakeEvfsHelp() {
       {"temporal_tv_weight", "model", "reconstruct video"},
       {"alpha", "model", "reconstruct video"},
       {"event_model", "model", "reconstruct video"},
+      {"event_saturation", "model", "reconstruct video"},
       {"log_offset", "model", "reconstruct video"},
       {"spatial_tv", "model", "reconstruct video"},
       {"smoothing_scale", "model", "reconstruct video"},

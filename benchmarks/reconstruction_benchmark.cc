@@ -42,6 +42,8 @@ DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_m
               "log | linear: the event model's intensity transform g.");
 DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset,
               "b of the log event model.");
+DEFINE_double(measured_saturation, evfs::EventModelEstimationOptions().measured_saturation,
+              "c of the event model when the change per event is measured between frames.");
 DEFINE_double(frame_weight, evfs::ObjectiveOptions().frame_weight, "weight of the frame term.");
 DEFINE_double(event_weight, evfs::ObjectiveOptions().event_weight, "lambda_e.");
 DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight, "lambda_t.");
@@ -87,6 +89,7 @@ ReconstructionOptions Options() {
   options.objective.event_model.alpha = FLAGS_alpha;
   options.objective.event_model.log_offset = FLAGS_log_offset;
   options.estimation.alpha_times_change = FLAGS_alpha_times_change;
+  options.estimation.measured_saturation = FLAGS_measured_saturation;
   options.solver.max_num_iterations = FLAGS_max_iterations;
   if (!ParseEventModel(FLAGS_event_model, &options.objective.event_model.model)) {
     throw InvalidArgumentError("--event_model: linear or log, got '" + FLAGS_event_model + "'");

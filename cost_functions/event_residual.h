@@ -26,7 +26,7 @@ struct EventResidual {
       : event_value(event_value),
         num_steps(num_steps),
         params(params),
-        saturation(SaturationForCount(event_value, num_steps)) {
+        saturation(SaturationForCount(event_value, num_steps, params.saturation)) {
     CHECK_GE(num_steps, 1);
     CheckEventModelParams(params);
   }
@@ -58,7 +58,9 @@ struct EventResidual {
 /// can use its fixed-size autodiff.
 struct OneStepEventResidual {
   OneStepEventResidual(double event_value, const EventModelParams& params)
-      : event_value(event_value), params(params), saturation(SaturationForCount(event_value, 1)) {
+      : event_value(event_value),
+        params(params),
+        saturation(SaturationForCount(event_value, 1, params.saturation)) {
     CheckEventModelParams(params);
   }
 
@@ -93,7 +95,7 @@ class EventResidualAnalytic : public ceres::SizedCostFunction<1, 1, 1> {
   EventResidualAnalytic(double event_value, const EventModelParams& params)
       : event_value_(event_value),
         params_(params),
-        saturation_(SaturationForCount(event_value, 1)) {
+        saturation_(SaturationForCount(event_value, 1, params.saturation)) {
     CheckEventModelParams(params);
   }
 

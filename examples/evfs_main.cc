@@ -132,6 +132,9 @@ DEFINE_double(temporal_tv_weight, evfs::ObjectiveOptions().temporal_tv_weight,
 DEFINE_double(alpha, 0.0,
               "alpha of tanh(alpha * dg); 0 derives it from the data's contrast "
               "threshold (printed).");
+DEFINE_double(event_saturation, 0.0,
+              "c of the event model c tanh(alpha dg / c), >= 1 (1: the paper's); 0 derives it: "
+              "above 1 when the change per event is measured between two frames, else 1.");
 DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_model.model),
               "log (g(x) = log(x + b), paper Eq. 1) | linear (g(x) = x, paper Eq. 2).");
 DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset,
@@ -369,6 +372,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   objective.temporal_tv_weight = FLAGS_temporal_tv_weight;
   objective.event_model.alpha = FLAGS_alpha;
   objective.event_model.log_offset = FLAGS_log_offset;
+  objective.event_model.saturation = FLAGS_event_saturation;
   objective.smoothing_scale = FLAGS_smoothing_scale;
   objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
   objective.spatial_tv = ParseName(kSpatialTvNames, FLAGS_spatial_tv, "--spatial_tv");

@@ -169,6 +169,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       DoubleOption<R>("temporal_tv_weight",
                       [](R& s) -> double& { return Objective(s).temporal_tv_weight; }),
       DoubleOption<R>("alpha", [](R& s) -> double& { return Objective(s).event_model.alpha; }),
+      DoubleOption<R>("event_saturation",
+                      [](R& s) -> double& { return Objective(s).event_model.saturation; }),
       EnumOption<R>("event_model", kEventModelNames,
                     [](R& s) -> EventModel& { return Objective(s).event_model.model; }),
       DoubleOption<R>("log_offset",

@@ -33,6 +33,12 @@ struct EventModelParams {
   EventModel model = EventModel::kLinear;  ///< the intensity transform g
   double alpha = 5.0;                      ///< slope of the tanh activation (paper Eq. 2), > 0
   double log_offset = 0.1;                 ///< b in log(x + b) (paper Eq. 1), > 0; kLog only
+  /// c of the predicted event c·tanh(α·Δg / c) for a step that holds at most one event, >= 1.
+  /// 1 is the paper's curve: it reaches 0.76 at α·Δg = 1, so an event pulls its step past the
+  /// change 1/α it stands for. A larger c keeps the curve nearly linear over one event's
+  /// change (c = 2: 0.92 at α·Δg = 1), so that one event predicts about 1/α. 0: derived with α
+  /// (ResolveObjective), and 1 where nothing derives it.
+  double saturation = 1.0;
 
   /// True when alpha > 0 and, for kLog, log_offset > 0; otherwise false with the reason in
   /// `*error` (when not null).
@@ -43,6 +49,10 @@ struct EventModelParams {
     }
     if (model == EventModel::kLog && !(log_offset > 0.0)) {
       check.Check(false, "log event model offset b must be > 0, got " + std::to_string(log_offset));
+    }
+    if (saturation != 0.0 && !(saturation >= 1.0 && std::isfinite(saturation))) {
+      check.Check(
+          false, "event model saturation c must be >= 1 (or 0), got " + std::to_string(saturation));
     }
     return check.Passed(error);
   }
@@ -94,11 +104,13 @@ T PredictedEvent(const T& intensity_before, const T& intensity_after,
                            saturation);
 }
 
-/// c of PredictedEvent for an event frame holding `event_value` over `num_steps` steps: at
-/// least 1 (the paper's model for collision frames and zero counts), else the count per step.
-inline double SaturationForCount(double event_value, int num_steps) {
+/// c of PredictedEvent for an event frame holding `event_value` over `num_steps` steps: the
+/// count per step, and at least `min_saturation` (EventModelParams::saturation) and 1 (the
+/// paper's model for collision frames and zero counts).
+inline double SaturationForCount(double event_value, int num_steps, double min_saturation = 1.0) {
   const double per_step = (event_value < 0.0 ? -event_value : event_value) / num_steps;
-  return per_step > 1.0 ? per_step : 1.0;
+  const double floor = min_saturation > 1.0 ? min_saturation : 1.0;
+  return per_step > floor ? per_step : floor;
 }
 
 }  // namespace evfs

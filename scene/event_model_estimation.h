@@ -28,6 +28,11 @@ struct EventModelEstimationOptions {
   double assumed_contrast_threshold = 0.2;
   /// Linear model: intensity change per event assumed when the scene cannot tell.
   double assumed_linear_change = 0.09;
+  /// c of the event model (EventModelParams::saturation) when Δg is measured between two sharp
+  /// frames: α = 1/Δg then says what one event stands for, and the curve should predict it
+  /// rather than push past it (c = 1). An assumed Δg keeps the paper's c = 1, with which
+  /// alpha_times_change and assumed_contrast_threshold were chosen.
+  double measured_saturation = 1.25;
   /// Fewest pixels with both a net event count and a matching frame change needed to trust an
   /// estimate from frames.
   int min_pixels = 100;
@@ -39,6 +44,8 @@ struct EventModelEstimate {
   double change_per_event = 0.0;  // Δg one event stands for, in the units of g
   bool estimated_from_frames = false;
   double alpha = 0.0;
+  /// c of the event model used with α (EventModelParams::saturation).
+  double saturation = 1.0;
   /// One line for logs and summaries, e.g.
   /// "change per event 0.0912 (measured between the frames at 4172 pixels), alpha 5.48".
   std::string description;

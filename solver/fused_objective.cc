@@ -461,12 +461,14 @@ void FusedObjective::Impl::TimeSeriesTerms(int y, int begin, int end, const doub
         // the other two vectorise.
         double* __restrict step_slope = scratch->step_slope.data() + s * width;
         for (int x = begin; x < end; ++x) {
-          const double saturation = SaturationForCount(observed[x], event.steps);
+          const double saturation =
+              SaturationForCount(observed[x], event.steps, event_model.saturation);
           step_slope[x] = 2.0 * (alpha * (g_after[x] - g_before[x]) / saturation);
         }
         for (int x = begin; x < end; ++x) step_slope[x] = std::exp(step_slope[x]);
         for (int x = begin; x < end; ++x) {
-          const double saturation = SaturationForCount(observed[x], event.steps);
+          const double saturation =
+              SaturationForCount(observed[x], event.steps, event_model.saturation);
           const double u = TanhFromExp(step_slope[x]);
           row_sum[x] += saturation * u;
           step_slope[x] = alpha * (1.0 - u * u);

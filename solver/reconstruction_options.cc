@@ -24,6 +24,9 @@ bool ObjectiveOptions::IsValid(std::string* error) const {
              "smoothing_scale must be positive")
       .Check(std::isfinite(event_model.alpha),
              "alpha must be finite (<= 0 derives it from the data)")
+      .Check(event_model.saturation == 0.0 ||
+                 (std::isfinite(event_model.saturation) && event_model.saturation >= 1.0),
+             "event_saturation (c of c tanh(alpha dg / c)) must be >= 1 (0 derives it)")
       .Check(event_model.model != EventModel::kLog ||
                  (std::isfinite(event_model.log_offset) && event_model.log_offset > 0.0),
              "log_offset (b of log(x + b)) must be positive")

@@ -60,6 +60,7 @@ struct ObjectiveOptions {
     params.model = EventModel::kLog;
     params.log_offset = 0.5;
     params.alpha = 0.0;
+    params.saturation = 0.0;
     return params;
   }
 };

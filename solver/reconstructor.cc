@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 #include "core/error.h"
@@ -155,6 +156,16 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
     // The change an event stands for when α was derived from it (EstimateEventModel).
     model->change_per_event = options.estimation.alpha_times_change / event_model.alpha;
     model->description = "alpha " + std::to_string(event_model.alpha) + " (given)";
+  }
+  if (event_model.saturation <= 0.0) {
+    event_model.saturation =
+        model->estimated_from_frames ? options.estimation.measured_saturation : 1.0;
+  }
+  model->saturation = event_model.saturation;
+  if (event_model.saturation != 1.0) {
+    std::ostringstream saturation;
+    saturation << ", saturation " << event_model.saturation;
+    model->description += saturation.str();
   }
   return objective;
 }

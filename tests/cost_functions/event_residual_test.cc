@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "tests/cost_functions/cost_function_testing.h"
@@ -88,6 +89,30 @@ TEST(EventResidual, NominalCountSaturatesAtTheCountPerStep) {
   EXPECT_DOUBLE_EQ(SaturationForCount(-1.0, 1), 1.0);
   EXPECT_DOUBLE_EQ(SaturationForCount(2.0, 4), 1.0);
   EXPECT_DOUBLE_EQ(SaturationForCount(-6.0, 2), 3.0);
+  // A model saturation c raises the floor, never the count per step.
+  EXPECT_DOUBLE_EQ(SaturationForCount(1.0, 1, 2.0), 2.0);
+  EXPECT_DOUBLE_EQ(SaturationForCount(-6.0, 2, 2.0), 3.0);
+  EXPECT_DOUBLE_EQ(SaturationForCount(1.0, 1, 0.0), 1.0);  // not derived: the paper's
+}
+
+TEST(EventResidual, ModelSaturationMakesOneEventPredictAboutOneChange) {
+  // One event at a step whose change is exactly 1/alpha: the paper's c = 1 predicts tanh(1) =
+  // 0.76 of it, c = 2 predicts 2 tanh(1/2) = 0.92.
+  EventModelParams params = LinearParams(5.0);
+  const std::unique_ptr<ceres::CostFunction> paper(EventResidual::Create(1.0, 1, params));
+  EXPECT_NEAR(test::Evaluate(*paper, {0.3, 0.5}).residuals[0], 1.0 - std::tanh(1.0),
+              kNominalTolerance);
+  params.saturation = 2.0;
+  const std::unique_ptr<ceres::CostFunction> saturated(EventResidual::Create(1.0, 1, params));
+  const test::Evaluation evaluation = test::Evaluate(*saturated, {0.3, 0.5});
+  EXPECT_NEAR(evaluation.residuals[0], 1.0 - 2.0 * std::tanh(0.5), kNominalTolerance);
+  // The slope at the step is alpha (1 - u²) with u = tanh(1/2).
+  const double u = std::tanh(0.5);
+  EXPECT_NEAR(evaluation.jacobians[0][0], 5.0 * (1.0 - u * u), kNominalTolerance);
+  params.saturation = 0.5;
+  std::string error;
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("saturation"), std::string::npos) << error;
 }
 
 TEST(EventResidual, CreateUsesFixedSizeAutoDiffForOneStep) {

@@ -282,6 +282,35 @@ TEST(Reconstructor, MemoryBudgetBeyondOneTebibyteIsRefused) {
 
 // A pixel no event fired, whose frames differ by less than one event's change, takes the blend
 // of the frames; a pixel that fired, and one whose frames differ by more, keep the solve's answer.
+TEST(Reconstructor, EventSaturationFollowsHowTheChangePerEventIsKnown) {
+  const test::SyntheticRecording recording;
+  const Scene interpolation = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                                     recording.events, BinningOptions());
+  const Scene prediction = MakePredictionScene(
+      recording.Sharp(0), recording.rendered.timestamp_ns(10), recording.events, BinningOptions());
+  ReconstructionOptions options;
+  EventModelEstimate model;
+  bool alpha_derived = false;
+  // Measured between two frames: the estimation's c.
+  options.estimation.measured_saturation = 3.0;
+  EXPECT_EQ(ResolveObjective(interpolation, options, &model, &alpha_derived).event_model.saturation,
+            3.0);
+  EXPECT_TRUE(model.estimated_from_frames);
+  EXPECT_EQ(model.saturation, 3.0);
+  // Assumed (one frame) or given: the paper's c = 1.
+  EXPECT_EQ(ResolveObjective(prediction, options, &model, &alpha_derived).event_model.saturation,
+            1.0);
+  options.objective.event_model.alpha = 5.0;
+  EXPECT_EQ(ResolveObjective(interpolation, options, &model, &alpha_derived).event_model.saturation,
+            1.0);
+  // A user's c wins.
+  options.objective.event_model.saturation = 1.5;
+  EXPECT_EQ(ResolveObjective(interpolation, options, &model, &alpha_derived).event_model.saturation,
+            1.5);
+  options.objective.event_model.saturation = 0.5;
+  EXPECT_THROW(Reconstruct(interpolation, options), InvalidArgumentError);
+}
+
 TEST(Reconstructor, QuietPixelsTakeTheBlendOfTheFrames) {
   Scene scene = MakeSceneWithEvents(6, 8, {{0, 2, 2}, {1, 2, 3}, {2, 3, 3}});
   scene.frames[0].image = Image::Constant(6, 8, 0.40);

@@ -161,9 +161,12 @@ TEST_P(FirstOrderStress, StaysFiniteAndDoesNotDegrade) {
   ObjectiveOptions objective = defaults.objective;
   objective.event_model.model = solver_scene.model;
   objective_case.configure(&objective);
-  if (objective.event_model.alpha <= 0.0) {
-    objective.event_model.alpha =
-        EstimateEventModel(stress.scene, objective.event_model, defaults.estimation).alpha;
+  {
+    ReconstructionOptions with_objective = defaults;
+    with_objective.objective = objective;
+    EventModelEstimate estimate;
+    bool alpha_derived = false;
+    objective = ResolveObjective(stress.scene, with_objective, &estimate, &alpha_derived);
   }
   const ActivityMask mask(stress.scene.events, defaults.activity_radius_px);
   const Video initial = InitializeLatentVideo(stress.scene);

@@ -91,11 +91,12 @@ inline double VideoPsnr(const Video& estimate, const Video& truth) {
   return std::min(psnr, kPsnrCeilingDb);
 }
 
-/// The options with α derived as Reconstruct derives it, so that a problem can be built with
-/// them directly.
+/// The options with the event model (α, c) derived as Reconstruct derives it, so that a problem
+/// can be built with them directly.
 inline ReconstructionOptions WithAlpha(const Scene& scene, ReconstructionOptions options) {
-  EventModelParams& model = options.objective.event_model;
-  if (model.alpha <= 0.0) model.alpha = EstimateEventModel(scene, model, options.estimation).alpha;
+  EventModelEstimate estimate;
+  bool alpha_derived = false;
+  options.objective = ResolveObjective(scene, options, &estimate, &alpha_derived);
   return options;
 }
 
