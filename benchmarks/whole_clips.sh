@@ -19,13 +19,16 @@ cd "$(dirname "$0")/.."
 evfs="$build/examples/evfs"
 mkdir -p "$scratch"
 
-# Prints "mean (worst) | blend mean | SSIM mean | blend SSIM" from a video's summary.json.
-scores() {
-  /usr/bin/python3 - "$1" <<'PY'
+# Prints the table row of CLIP WALL_S from its evfs and its integration summary.json.
+row() {
+  /usr/bin/python3 - "$@" <<'PY'
 import json, sys
-t = json.load(open(sys.argv[1]))["truth"]
-print("%.2f (%.2f) | %.2f | %.4f | %.4f | %d" % (t["mean_psnr"], t["worst_psnr"],
-      t["blend_mean_psnr"], t["mean_ssim"], t["blend_mean_ssim"], t["frames"]))
+clip, wall, evfs, integration = sys.argv[1:]
+e = json.load(open(evfs))["truth"]
+i = json.load(open(integration))["truth"]
+print("| %s | %d | %.2f (%.2f) | %.2f | %.2f | %.4f | %.4f | %.4f | %.0f s |" % (
+    clip, e["frames"], e["mean_psnr"], e["worst_psnr"], e["blend_mean_psnr"], i["mean_psnr"],
+    e["mean_ssim"], e["blend_mean_ssim"], i["mean_ssim"], float(wall)))
 PY
 }
 
@@ -40,10 +43,5 @@ for clip in "${clips[@]}"; do
   wall=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
   "$evfs" video --data="$sim" --out="$scratch/integrate_$clip" --overwrite --frame_step=4 \
     --fps=240 --solver=integrate >/dev/null 2>&1
-  IFS='|' read -r evfs_psnr blend evfs_ssim blend_ssim frames <<<"$(scores "$scratch/out_$clip/summary.json")"
-  IFS='|' read -r integration _ integration_ssim _ _ <<<"$(scores "$scratch/integrate_$clip/summary.json")"
-  integration=${integration%% (*}
-  printf "| %s | %s | %s | %s | %s | %s | %s | %s | %.0f s |\n" "$clip" "${frames// /}" \
-    "${evfs_psnr% }" "${blend// /}" "${integration// /}" "${evfs_ssim// /}" "${blend_ssim// /}" \
-    "${integration_ssim// /}" "$wall"
+  row "$clip" "$wall" "$scratch/out_$clip/summary.json" "$scratch/integrate_$clip/summary.json"
 done
