@@ -72,6 +72,7 @@ ProgramHelp MakeEvfsHelp() {
       {"max_latent_frames", "binning", "info reconstruct video"},
       {"max_latent_voxels", "binning", "info reconstruct video"},
       {"hot_pixel_factor", "binning", "info reconstruct video"},
+      {"noise_filter_ms", "binning", "info reconstruct video"},
       {"stacked_frames", "binning", "info reconstruct video"},
       // The objective and the unknowns.
       {"frame_weight", "model", "reconstruct video"},

@@ -214,6 +214,7 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   result.event_frames = scene.events.num_frames();
   result.hot_pixels = static_cast<int>(scene.hot_pixels.size());
   result.hot_pixel_events = scene.hot_pixel_events;
+  result.noise_events = scene.noise_events;
   result.time.bin_s = SecondsSince(bin_start);
 
   result.baseline = InitializeLatentVideo(scene);
@@ -375,6 +376,7 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json["events"] = result.events;
   json["hot_pixels"] = result.hot_pixels;
   json["hot_pixel_events"] = result.hot_pixel_events;
+  json["noise_events"] = result.noise_events;
   json["event_frames"] = result.event_frames;
   json["latent_frames"] = run.video.num_frames();
   json["output_frames"] = result.output.num_frames();

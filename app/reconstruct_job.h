@@ -79,6 +79,7 @@ struct ReconstructResult {
   int event_frames = 0;
   int hot_pixels = 0;            // pixels whose events were left out as hot (BinningOptions)
   int64_t hot_pixel_events = 0;  // their events
+  int64_t noise_events = 0;      // left out by the background-activity filter
   MethodResult run;              // latent video and what the method did
   Video output;                  // the latent video, or its resampling at request.fps
   Video baseline;                // blend or copy on the latent timeline (the score's reference)

@@ -72,6 +72,9 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
           (activity.hot_pixels.size() == 1 ? "" : "s") + " (" +
           std::to_string(activity.hot_pixel_events) + " events left out)";
   }
+  if (plan.noise_events > 0) {
+    hot += ", " + std::to_string(plan.noise_events) + " unsupported events left out as noise";
+  }
   std::fprintf(
       out,
       "window      frames %d..%d, %.6f s: %zu events (%zu ON, %zu OFF) at %lld pixels "
@@ -108,6 +111,10 @@ void PrintReconstruction(const ReconstructRequest& request, const ReconstructRes
   if (result.hot_pixels > 0) {
     std::fprintf(out, "hot pixels: %d, their %lld events left out (--hot_pixel_factor)\n",
                  result.hot_pixels, static_cast<long long>(result.hot_pixel_events));
+  }
+  if (result.noise_events > 0) {
+    std::fprintf(out, "noise: %lld unsupported events left out (--noise_filter_ms)\n",
+                 static_cast<long long>(result.noise_events));
   }
   if (result.mode != Mode::kDeblur && request.frame_time != FrameTime::kInstant) {
     std::fprintf(

@@ -247,6 +247,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["output_frames"] = {begin, end};
   record["events"] = scene.num_events;
   record["hot_pixels"] = scene.hot_pixels.size();
+  record["noise_events"] = scene.noise_events;
   record["event_frames"] = scene.events.num_frames();
   record["latent_frames"] = latent.num_frames();
   record["solved"] = run.solved;

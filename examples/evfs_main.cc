@@ -119,6 +119,9 @@ DEFINE_double(hot_pixel_factor, evfs::BinningOptions().hot_pixel_factor,
               "Leave out the events of hot pixels: those firing more than this many times as "
               "often as the window's busy pixels (the busiest outside the top 1 %); 0 keeps "
               "every event.");
+DEFINE_double(noise_filter_ms, evfs::BinningOptions().noise_filter_ms,
+              "Leave out events that no neighbouring pixel confirms within this many ms "
+              "(background-activity filter); 0 keeps every event.");
 DEFINE_int32(stacked_frames, evfs::BinningOptions().stacked.num_frames,
              "stacked binning: number of event frames.");
 // Objective.
@@ -261,6 +264,7 @@ BinningOptions BinningFromFlags() {
   binning.max_latent_frames = FLAGS_max_latent_frames;
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
+  binning.noise_filter_ms = FLAGS_noise_filter_ms;
   binning.stacked.num_frames = FLAGS_stacked_frames;
   return binning;
 }

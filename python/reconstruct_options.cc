@@ -159,6 +159,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
                    [](R& s) -> int64_t& { return s.request.binning.max_latent_voxels; }),
       DoubleOption<R>("hot_pixel_factor",
                       [](R& s) -> double& { return s.request.binning.hot_pixel_factor; }),
+      DoubleOption<R>("noise_filter_ms",
+                      [](R& s) -> double& { return s.request.binning.noise_filter_ms; }),
       IntOption<R>("stacked_frames",
                    [](R& s) -> int& { return s.request.binning.stacked.num_frames; }),
       // Model.

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/option_checker.h"
+#include "events/noise_filter.h"
 
 namespace evfs {
 namespace {
@@ -16,22 +17,29 @@ std::string VoxelCount(int64_t latent_frames, int64_t pixels) {
          " pixels = " + std::to_string(latent_frames * pixels) + " voxels";
 }
 
-// PlanBinning; also the events it bins (hot pixels left out) in *kept when it left any out.
+// PlanBinning; *binned receives the events it bins: `events`, or *kept when hot pixels or
+// unsupported events were left out.
 BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t end_ns,
-                          const BinningOptions& binning, EventStream* kept) {
+                          const BinningOptions& binning, EventStream* kept,
+                          const EventStream** binned) {
   std::string error;
   if (!binning.IsValid(&error)) throw InvalidArgumentError("binning: " + error);
   BinningPlan plan;
   plan.pixels = static_cast<int64_t>(events.width()) * events.height();
   plan.activity = MeasurePixelActivity(events, begin_ns, end_ns, binning.hot_pixel_factor);
-  const EventStream* binned = &events;
+  *binned = &events;
   if (!plan.activity.hot_pixels.empty()) {
     *kept = WithoutPixels(events, plan.activity.hot_pixels);
-    binned = kept;
+    *binned = kept;
+  }
+  if (binning.noise_filter_ms > 0.0) {
+    const int64_t window_ns = std::llround(binning.noise_filter_ms * 1e6);
+    *kept = WithoutUnsupportedEvents(**binned, window_ns, &plan.noise_events);
+    *binned = kept;
   }
   // Counting first is what bounds the memory: collision frames are allocated only once they
   // are known to fit (one hot pixel or a busy large sensor gives thousands of them).
-  plan.collision_frames = CountCollisionFrames(*binned, begin_ns, end_ns);
+  plan.collision_frames = CountCollisionFrames(**binned, begin_ns, end_ns);
   // N collision frames span N + 1 latent frames; an empty window still has its two ends.
   const int64_t collision_latent_frames = std::max<int64_t>(plan.collision_frames, 1) + 1;
   const int64_t cap = binning.max_latent_voxels;
@@ -103,7 +111,9 @@ bool BinningOptions::IsValid(std::string* error) const {
   check
       .Check(max_latent_frames >= 1 && max_latent_voxels >= 1,
              "max_latent_frames and max_latent_voxels must be at least 1")
-      .NonNegative("hot_pixel_factor", hot_pixel_factor);
+      .NonNegative("hot_pixel_factor", hot_pixel_factor)
+      .Check(noise_filter_ms >= 0.0 && noise_filter_ms <= kMaxNoiseFilterMs,
+             "noise_filter_ms must lie in [0, 3600000] (an hour)");
   if (method == Method::kStacked) check.Valid(stacked);
   return check.Passed(error);
 }
@@ -111,7 +121,8 @@ bool BinningOptions::IsValid(std::string* error) const {
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
                         const BinningOptions& binning) {
   EventStream kept;
-  return PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept);
+  const EventStream* binned = nullptr;
+  return PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept, &binned);
 }
 
 Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events,
@@ -132,14 +143,16 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
                                std::to_string(scene.width) + "x" + std::to_string(scene.height));
   }
   EventStream kept;
-  const BinningPlan plan = PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept);
-  const EventStream& binned = plan.activity.hot_pixels.empty() ? events : kept;
+  const EventStream* binned = nullptr;
+  const BinningPlan plan =
+      PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept, &binned);
   scene.events = plan.method == BinningOptions::Method::kCollision
-                     ? BinByCollision(binned, window_begin_ns, window_end_ns)
-                     : BinStacked(binned, window_begin_ns, window_end_ns, plan.stacked);
+                     ? BinByCollision(*binned, window_begin_ns, window_end_ns)
+                     : BinStacked(*binned, window_begin_ns, window_end_ns, plan.stacked);
   for (const EventFrameSpan& span : scene.events.spans()) scene.num_events += span.num_events;
   scene.hot_pixels = plan.activity.hot_pixels;
   scene.hot_pixel_events = plan.activity.hot_pixel_events;
+  scene.noise_events = plan.noise_events;
 
   const std::vector<int64_t>& latent_ns = scene.latent_timestamps_ns();
   for (const TimedFrame& frame : frames) {

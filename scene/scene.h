@@ -39,6 +39,9 @@ struct FrameObservation {
 /// is allocated, and one that would exceed it is either avoided (kAuto) or refused (kCollision,
 /// kStacked: InvalidArgumentError naming the option).
 struct BinningOptions {
+  /// The longest noise_filter_ms accepted: an hour.
+  static constexpr double kMaxNoiseFilterMs = 3.6e6;
+
   enum class Method {
     kAuto,       // collision binning unless it gives more steps than the limits allow
     kCollision,  // the paper's Binning 1: one step per collision frame, values in {-1, 0, 1}
@@ -58,6 +61,10 @@ struct BinningOptions {
   /// stuck pixel neither multiplies the collision frames nor bends its own pixel; 0 keeps every
   /// event. 10 is more than twice the largest ratio in the shared DAVIS recordings (4.4).
   double hot_pixel_factor = 10.0;
+  /// Every method: after the hot pixels, events that no neighbouring pixel confirms within this
+  /// many milliseconds are left out as background activity (WithoutUnsupportedEvents); 0 keeps
+  /// them.
+  double noise_filter_ms = 0.0;
   StackedBinningOptions stacked;  // used by kStacked
 
   bool IsValid(std::string* error) const;
@@ -79,6 +86,7 @@ struct BinningPlan {
   int64_t pixels = 0;            // of the sensor
   int64_t collision_frames = 0;  // what collision binning gives, hot pixels left out
   PixelActivity activity;        // hot pixels and counts, before leaving any out
+  int64_t noise_events = 0;      // left out by the background-activity filter
 
   int64_t latent_voxels() const { return pixels * num_latent_frames; }
 };
@@ -100,6 +108,8 @@ struct Scene {
   /// Pixels whose events were left out as hot (row-major indices), and how many events they had.
   std::vector<int32_t> hot_pixels;
   int64_t hot_pixel_events = 0;
+  /// Events left out by the background-activity filter (BinningOptions::noise_filter_ms).
+  int64_t noise_events = 0;
 
   int num_latent_frames() const { return static_cast<int>(events.latent_timestamps_ns().size()); }
   const std::vector<int64_t>& latent_timestamps_ns() const { return events.latent_timestamps_ns(); }

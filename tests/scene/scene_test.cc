@@ -6,10 +6,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <new>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -217,6 +219,54 @@ TEST(Scene, HotPixelDoesNotMultiplyTheLatentSteps) {
   EXPECT_TRUE(kept.hot_pixels.empty());
   EXPECT_EQ(kept.num_latent_frames(), keep_all.max_latent_frames + 1);
   EXPECT_EQ(kept.num_events, clean.num_events + 1000);
+}
+
+// The background-activity filter (issue 16) runs before binning: isolated events added to a
+// recording are left out and counted, the recording's own edges are kept, and a filtered event
+// neither fires a pixel nor opens a collision frame.
+TEST(Scene, NoiseFilterLeavesOutIsolatedEventsBeforeBinning) {
+  const test::SyntheticRecording recording;
+  const int64_t begin_ns = recording.rendered.timestamp_ns(0);
+  const int64_t end_ns = recording.rendered.timestamp_ns(20);
+  // Five lone events at the corners and centre of the sensor, 1 ms into the window.
+  const int w = recording.events.width(), h = recording.events.height();
+  EventStream noisy(w, h);
+  const int64_t t_noise = begin_ns + 1000000;
+  bool added = false;
+  for (size_t i = 0; i <= recording.events.size(); ++i) {
+    if (!added && (i == recording.events.size() || recording.events.t_ns(i) > t_noise)) {
+      for (const auto& [x, y] : {std::pair{0, 0}, {w - 1, 0}, {0, h - 1}, {w - 1, h - 1}}) {
+        noisy.push_back(t_noise, x, y, 1);
+      }
+      added = true;
+    }
+    if (i < recording.events.size()) {
+      noisy.push_back(recording.events.t_ns(i), recording.events.x(i), recording.events.y(i),
+                      recording.events.polarity(i));
+    }
+  }
+  BinningOptions filtered;
+  filtered.noise_filter_ms = 2.0;
+  const Scene kept_all = MakePredictionScene(recording.Sharp(0), end_ns, noisy, BinningOptions());
+  const Scene scene = MakePredictionScene(recording.Sharp(0), end_ns, noisy, filtered);
+  EXPECT_EQ(kept_all.noise_events, 0);
+  EXPECT_GE(scene.noise_events, 4);
+  EXPECT_EQ(scene.num_events + scene.noise_events, kept_all.num_events);
+  // The synthetic scene's moving shapes fire runs of neighbouring pixels: few of its own events
+  // are alone within 2 ms.
+  EXPECT_LT(scene.noise_events, kept_all.num_events / 20);
+  for (const auto& [x, y] : {std::pair{0, 0}, {w - 1, 0}, {0, h - 1}, {w - 1, h - 1}}) {
+    double fired = 0.0;
+    for (int k = 0; k < scene.events.num_frames(); ++k)
+      fired += std::abs(scene.events.value(k, y, x));
+    EXPECT_EQ(fired, 0.0) << "pixel " << x << ", " << y;
+  }
+
+  BinningOptions invalid;
+  invalid.noise_filter_ms = -1.0;
+  std::string error;
+  EXPECT_FALSE(invalid.IsValid(&error));
+  EXPECT_NE(error.find("noise_filter_ms"), std::string::npos) << error;
 }
 
 #if !defined(__SANITIZE_ADDRESS__) && !EVFS_HAS_FEATURE(address_sanitizer) && \

@@ -1,0 +1,68 @@
+#include "events/noise_filter.h"
+
+#include <limits>
+#include <vector>
+
+namespace evfs {
+namespace {
+
+constexpr int64_t kNever = std::numeric_limits<int64_t>::min() / 2;
+
+// One pass over the events in the order `order` (+1: forward in time, -1: backward). Marks in
+// *supported the events for which a neighbour fired within window_ns on the side already
+// passed: `last[q]` holds the time of pixel q's latest event seen, negated when going backward
+// so that "within the window" reads the same both ways.
+void MarkSupport(const EventStream& events, int64_t window_ns, int order,
+                 std::vector<uint8_t>* supported) {
+  const int width = events.width();
+  const int height = events.height();
+  std::vector<int64_t> last(static_cast<size_t>(width) * height, kNever);
+  const int64_t n = static_cast<int64_t>(events.size());
+  for (int64_t k = 0; k < n; ++k) {
+    const size_t i = static_cast<size_t>(order > 0 ? k : n - 1 - k);
+    const int x = events.x(i);
+    const int y = events.y(i);
+    if (x >= width || y >= height) continue;
+    const int64_t t = order > 0 ? events.t_ns(i) : -events.t_ns(i);
+    if (!(*supported)[i]) {
+      for (int dy = -1; dy <= 1 && !(*supported)[i]; ++dy) {
+        const int qy = y + dy;
+        if (qy < 0 || qy >= height) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx;
+          if ((dx == 0 && dy == 0) || qx < 0 || qx >= width) continue;
+          if (t - last[static_cast<size_t>(qy) * width + qx] <= window_ns) {
+            (*supported)[i] = 1;
+            break;
+          }
+        }
+      }
+    }
+    last[static_cast<size_t>(y) * width + x] = t;
+  }
+}
+
+}  // namespace
+
+EventStream WithoutUnsupportedEvents(const EventStream& events, int64_t window_ns,
+                                     int64_t* removed) {
+  if (removed != nullptr) *removed = 0;
+  if (window_ns <= 0 || events.empty()) return events;
+  std::vector<uint8_t> keep(events.size(), 0);
+  MarkSupport(events, window_ns, +1, &keep);
+  MarkSupport(events, window_ns, -1, &keep);
+  size_t count = 0;
+  for (size_t i = 0; i < events.size(); ++i) {
+    if (events.x(i) >= events.width() || events.y(i) >= events.height()) keep[i] = 1;
+    count += keep[i];
+  }
+  EventStream kept(events.width(), events.height());
+  kept.reserve(count);
+  for (size_t i = 0; i < events.size(); ++i) {
+    if (keep[i]) kept.push_back(events.t_ns(i), events.x(i), events.y(i), events.polarity(i));
+  }
+  if (removed != nullptr) *removed = static_cast<int64_t>(events.size() - count);
+  return kept;
+}
+
+}  // namespace evfs
