@@ -165,6 +165,7 @@ DenoiseRecord PlugAndPlayLatentVideo(const Denoiser& denoiser, const Scene& scen
   ReconstructionOptions options = method.reconstruction;
   options.objective.event_model.alpha = solved->reconstruction.model.alpha;
   options.objective.event_model.saturation = solved->reconstruction.model.saturation;
+  options.objective.event_model.off_alpha_ratio = solved->reconstruction.model.off_alpha_ratio;
   latent = PlugAndPlay(scene, options, denoiser, region, latent, pnp, &record.pnp, &record.stats);
   return record;
 }

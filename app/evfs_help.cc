@@ -82,6 +82,7 @@ ProgramHelp MakeEvfsHelp() {
       {"alpha", "model", "reconstruct video"},
       {"event_model", "model", "reconstruct video"},
       {"event_saturation", "model", "reconstruct video"},
+      {"per_polarity_alpha", "model", "reconstruct video"},
       {"log_offset", "model", "reconstruct video"},
       {"spatial_tv", "model", "reconstruct video"},
       {"smoothing_scale", "model", "reconstruct video"},

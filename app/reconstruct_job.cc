@@ -320,6 +320,7 @@ Json ModelJson(const ObjectiveOptions& objective, const ReconstructionSummary& s
   json["alpha"] = Number(summary.model.alpha);
   json["alpha_derived"] = summary.alpha_derived;
   json["event_saturation"] = Number(summary.model.saturation);
+  json["off_alpha_ratio"] = Number(summary.model.off_alpha_ratio);
   if (summary.alpha_derived) {
     json["change_per_event"] = Number(summary.model.change_per_event);
     json["change_measured_from_frames"] = summary.model.estimated_from_frames;

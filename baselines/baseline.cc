@@ -39,7 +39,9 @@ Threshold ThresholdFromFrames(const Scene& scene, const BaselineOptions& options
   EventModelParams model;
   model.model = log ? EventModel::kLog : EventModel::kLinear;
   model.log_offset = options.log_offset;
-  const EventModelEstimate estimate = EstimateEventModel(scene, model, options.estimation);
+  EventModelEstimationOptions estimation = options.estimation;
+  estimation.per_polarity = false;  // one threshold for both polarities
+  const EventModelEstimate estimate = EstimateEventModel(scene, model, estimation);
   return {estimate.change_per_event,
           estimate.estimated_from_frames
               ? "measured between the sharp frames (median change per net event)"

@@ -108,7 +108,9 @@ class EventResidualAnalytic : public ceres::SizedCostFunction<1, 1, 1> {
     residuals[0] = event_value_ - predicted_event;
     if (jacobians == nullptr) return true;
     const double u = predicted_event / saturation_;
-    const double slope = params_.alpha * (1.0 - u * u);
+    const double change = IntensityTransform(intensity_after, params_) -
+                          IntensityTransform(intensity_before, params_);
+    const double slope = params_.AlphaFor(change) * (1.0 - u * u);
     if (jacobians[0] != nullptr) {
       jacobians[0][0] = slope * IntensityTransformDerivative(intensity_before, params_);
     }

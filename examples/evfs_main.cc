@@ -138,6 +138,10 @@ DEFINE_double(alpha, 0.0,
 DEFINE_double(event_saturation, 0.0,
               "c of the event model c tanh(alpha dg / c), >= 1 (1: the paper's); 0 derives it: "
               "above 1 when the change per event is measured between two frames, else 1.");
+DEFINE_bool(per_polarity_alpha, evfs::EventModelEstimationOptions().per_polarity,
+            "With a derived alpha measured between two frames: measure the change per event "
+            "apart for ON and OFF events (DAVIS thresholds differ) and give darkening steps "
+            "their own alpha.");
 DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_model.model),
               "log (g(x) = log(x + b), paper Eq. 1) | linear (g(x) = x, paper Eq. 2).");
 DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset,
@@ -377,6 +381,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   objective.event_model.alpha = FLAGS_alpha;
   objective.event_model.log_offset = FLAGS_log_offset;
   objective.event_model.saturation = FLAGS_event_saturation;
+  options.estimation.per_polarity = FLAGS_per_polarity_alpha;
   objective.smoothing_scale = FLAGS_smoothing_scale;
   objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
   objective.spatial_tv = ParseName(kSpatialTvNames, FLAGS_spatial_tv, "--spatial_tv");

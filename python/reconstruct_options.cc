@@ -173,6 +173,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       DoubleOption<R>("alpha", [](R& s) -> double& { return Objective(s).event_model.alpha; }),
       DoubleOption<R>("event_saturation",
                       [](R& s) -> double& { return Objective(s).event_model.saturation; }),
+      BoolOption<R>("per_polarity_alpha",
+                    [](R& s) -> bool& { return Rec(s).estimation.per_polarity; }),
       EnumOption<R>("event_model", kEventModelNames,
                     [](R& s) -> EventModel& { return Objective(s).event_model.model; }),
       DoubleOption<R>("log_offset",

@@ -39,6 +39,17 @@ struct EventModelParams {
   /// change (c = 2: 0.92 at α·Δg = 1), so that one event predicts about 1/α. 0: derived with α
   /// (ResolveObjective), and 1 where nothing derives it.
   double saturation = 1.0;
+  /// α of a darkening step over α of a brightening one, > 0. A DAVIS pixel's OFF threshold is
+  /// lower than its ON threshold (on the shared recordings one OFF event stands for 0.65–0.75
+  /// of the change one ON event does), so an OFF event predicts a smaller change: darkening
+  /// steps use the slope alpha · off_alpha_ratio. 1: one slope (the paper's model).
+  double off_alpha_ratio = 1.0;
+
+  /// α of the step from g_before to g_after: alpha, times off_alpha_ratio when it darkens.
+  template <typename T>
+  double AlphaFor(const T& g_change) const {
+    return g_change < T(0.0) ? alpha * off_alpha_ratio : alpha;
+  }
 
   /// True when alpha > 0 and, for kLog, log_offset > 0; otherwise false with the reason in
   /// `*error` (when not null).
@@ -49,6 +60,10 @@ struct EventModelParams {
     }
     if (model == EventModel::kLog && !(log_offset > 0.0)) {
       check.Check(false, "log event model offset b must be > 0, got " + std::to_string(log_offset));
+    }
+    if (!(off_alpha_ratio > 0.0 && std::isfinite(off_alpha_ratio))) {
+      check.Check(false, "event model OFF/ON alpha ratio must be > 0, got " +
+                             std::to_string(off_alpha_ratio));
     }
     if (saturation != 0.0 && !(saturation >= 1.0 && std::isfinite(saturation))) {
       check.Check(
@@ -87,7 +102,8 @@ inline double IntensityTransformDerivative(double intensity, const EventModelPar
   return intensity >= 0.0 ? 1.0 / (intensity + params.log_offset) : 0.0;
 }
 
-/// Predicted event value of one latent step: c tanh(alpha (g(after) - g(before)) / c).
+/// Predicted event value of one latent step: c tanh(alpha (g(after) - g(before)) / c), with
+/// params.AlphaFor the change (the OFF slope for a darkening step).
 ///
 /// c = 1 is the paper's model (Eq. 2): a collision-binned step holds at most one event. A step
 /// of a stacked event frame (Binning 2) holds a signed count, which tanh cannot reach; the
@@ -98,10 +114,9 @@ template <typename T>
 T PredictedEvent(const T& intensity_before, const T& intensity_after,
                  const EventModelParams& params, double saturation = 1.0) {
   using std::tanh;
-  return saturation * tanh(params.alpha *
-                           (IntensityTransform(intensity_after, params) -
-                            IntensityTransform(intensity_before, params)) /
-                           saturation);
+  const T change =
+      IntensityTransform(intensity_after, params) - IntensityTransform(intensity_before, params);
+  return saturation * tanh(params.AlphaFor(change) * change / saturation);
 }
 
 /// c of PredictedEvent for an event frame holding `event_value` over `num_steps` steps: the

@@ -54,20 +54,28 @@ EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams
   }
   int pixels_used = 0;
   double change = 0.0;
+  double change_off = 0.0;  // measured per polarity: Δg of an OFF event (change: of an ON one)
   if (first && last && first->latent_first < last->latent_first) {
     const std::vector<double> net = NetEventCount(scene, first->latent_first, last->latent_first);
-    std::vector<double> per_event;
+    std::vector<double> per_on_event, per_off_event;
     for (size_t p = 0; p < net.size(); ++p) {
       if (net[p] == 0.0) continue;
       const double frame_change = IntensityTransform(last->image.data()[p], model) -
                                   IntensityTransform(first->image.data()[p], model);
       if (frame_change * net[p] <= 0.0) continue;  // frames and events disagree: noise, occlusion
-      per_event.push_back(frame_change / net[p]);
+      (net[p] > 0.0 ? per_on_event : per_off_event).push_back(frame_change / net[p]);
     }
-    if (static_cast<int>(per_event.size()) >= options.min_pixels) {
-      change = Median(per_event);
+    pixels_used = static_cast<int>(per_on_event.size() + per_off_event.size());
+    if (pixels_used >= options.min_pixels) {
       estimate.estimated_from_frames = true;
-      pixels_used = static_cast<int>(per_event.size());
+      if (options.per_polarity && static_cast<int>(per_on_event.size()) >= options.min_pixels &&
+          static_cast<int>(per_off_event.size()) >= options.min_pixels) {
+        change = Median(per_on_event);
+        change_off = Median(per_off_event);
+      } else {
+        per_on_event.insert(per_on_event.end(), per_off_event.begin(), per_off_event.end());
+        change = Median(per_on_event);
+      }
     }
   }
 
@@ -79,7 +87,14 @@ EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams
   estimate.alpha = options.alpha_times_change / change;
 
   char line[256];
-  if (estimate.estimated_from_frames) {
+  if (change_off > 0.0) {
+    estimate.off_alpha_ratio = change / change_off;
+    std::snprintf(line, sizeof(line),
+                  "change per event ON %.4f, OFF %.4f (measured between the frames at %d "
+                  "pixels), alpha %.2f, OFF %.2f",
+                  change, change_off, pixels_used, estimate.alpha,
+                  estimate.alpha * estimate.off_alpha_ratio);
+  } else if (estimate.estimated_from_frames) {
     std::snprintf(line, sizeof(line),
                   "change per event %.4f (measured between the frames at %d pixels), "
                   "alpha %.2f",

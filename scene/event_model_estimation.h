@@ -36,6 +36,10 @@ struct EventModelEstimationOptions {
   /// Fewest pixels with both a net event count and a matching frame change needed to trust an
   /// estimate from frames.
   int min_pixels = 100;
+  /// When Δg is measured and both polarities have min_pixels pixels: measure it apart for the
+  /// pixels that brightened (ON) and darkened (OFF), α = alpha_times_change / Δg_ON and
+  /// EventModelParams::off_alpha_ratio = Δg_ON / Δg_OFF. Otherwise one Δg for both.
+  bool per_polarity = true;
 
   bool IsValid(std::string* error) const;
 };
@@ -44,6 +48,8 @@ struct EventModelEstimate {
   double change_per_event = 0.0;  // Δg one event stands for, in the units of g
   bool estimated_from_frames = false;
   double alpha = 0.0;
+  /// EventModelParams::off_alpha_ratio: Δg_ON / Δg_OFF when measured per polarity, else 1.
+  double off_alpha_ratio = 1.0;
   /// c of the event model used with α (EventModelParams::saturation).
   double saturation = 1.0;
   /// One line for logs and summaries, e.g.

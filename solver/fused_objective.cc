@@ -449,7 +449,6 @@ void FusedObjective::Impl::TimeSeriesTerms(int y, int begin, int end, const doub
         for (int x = begin; x < end; ++x) g[x] = std::log(g[x]);
       }
     }
-    const double alpha = event_model.alpha;
     for (const EventTerm& event : event_terms) {
       // r = E − Σ_s c tanh(α (g(H_{s+1}) − g(H_s)) / c)  (EventResidual)
       const float* observed = event.values + row_start;
@@ -463,7 +462,8 @@ void FusedObjective::Impl::TimeSeriesTerms(int y, int begin, int end, const doub
         for (int x = begin; x < end; ++x) {
           const double saturation =
               SaturationForCount(observed[x], event.steps, event_model.saturation);
-          step_slope[x] = 2.0 * (alpha * (g_after[x] - g_before[x]) / saturation);
+          const double change = g_after[x] - g_before[x];
+          step_slope[x] = 2.0 * (event_model.AlphaFor(change) * change / saturation);
         }
         for (int x = begin; x < end; ++x) step_slope[x] = std::exp(step_slope[x]);
         for (int x = begin; x < end; ++x) {
@@ -471,7 +471,7 @@ void FusedObjective::Impl::TimeSeriesTerms(int y, int begin, int end, const doub
               SaturationForCount(observed[x], event.steps, event_model.saturation);
           const double u = TanhFromExp(step_slope[x]);
           row_sum[x] += saturation * u;
-          step_slope[x] = alpha * (1.0 - u * u);
+          step_slope[x] = event_model.AlphaFor(g_after[x] - g_before[x]) * (1.0 - u * u);
         }
       }
       for (int x = begin; x < end; ++x) {

@@ -150,6 +150,7 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
   if (*alpha_derived) {
     *model = EstimateEventModel(scene, event_model, options.estimation);
     event_model.alpha = model->alpha;
+    event_model.off_alpha_ratio = model->off_alpha_ratio;
   } else {
     *model = EventModelEstimate();
     model->alpha = event_model.alpha;

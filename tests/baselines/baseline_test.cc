@@ -189,10 +189,13 @@ TEST(Baseline, ReportsTheThresholdItUsed) {
   EXPECT_EQ(Parameter(given, "contrast_threshold"), 0.123);
   EXPECT_EQ(given.threshold_source, "given");
 
-  // Derived from the two sharp frames the way the solver derives its change per event.
+  // Derived from the two sharp frames the way the solver derives its change per event, with
+  // both polarities together (one threshold).
   EventModelParams linear;
   linear.model = EventModel::kLinear;
-  const EventModelEstimate estimate = EstimateEventModel(scene, linear, options.estimation);
+  EventModelEstimationOptions together = options.estimation;
+  together.per_polarity = false;
+  const EventModelEstimate estimate = EstimateEventModel(scene, linear, together);
   ASSERT_TRUE(estimate.estimated_from_frames);
   const BaselineResult derived = RunBaseline(BaselineMethod::kIntegrate, scene, BaselineOptions());
   EXPECT_EQ(Parameter(derived, "contrast_threshold"), estimate.change_per_event);

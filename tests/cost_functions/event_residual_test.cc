@@ -115,6 +115,31 @@ TEST(EventResidual, ModelSaturationMakesOneEventPredictAboutOneChange) {
   EXPECT_NE(error.find("saturation"), std::string::npos) << error;
 }
 
+TEST(EventResidual, DarkeningStepsUseTheOffSlope) {
+  EventModelParams params = LinearParams(5.0);
+  params.off_alpha_ratio = 2.0;
+  const std::unique_ptr<ceres::CostFunction> cost(EventResidual::Create(1.0, 1, params));
+  // Brightening by 0.1: tanh(5 · 0.1); darkening by 0.1: tanh(-2 · 5 · 0.1).
+  EXPECT_NEAR(test::Evaluate(*cost, {0.3, 0.4}).residuals[0], 1.0 - std::tanh(0.5),
+              kNominalTolerance);
+  const test::Evaluation darkening = test::Evaluate(*cost, {0.4, 0.3});
+  EXPECT_NEAR(darkening.residuals[0], 1.0 - std::tanh(-1.0), kNominalTolerance);
+  const double u = std::tanh(-1.0);
+  EXPECT_NEAR(darkening.jacobians[0][0], 10.0 * (1.0 - u * u), kNominalTolerance);
+  // The analytic form agrees on both sides.
+  std::mt19937 rng(11);
+  for (int i = 0; i < test::kRandomPoints; ++i) {
+    const EventResidualAnalytic analytic(-1.0, params);
+    const std::unique_ptr<ceres::CostFunction> autodiff(EventResidual::Create(-1.0, 1, params));
+    test::ExpectSameEvaluation(*autodiff, analytic, test::RandomIntensities(&rng, 2, 0.0, 1.0),
+                               test::kAnalyticTolerance);
+  }
+  params.off_alpha_ratio = 0.0;
+  std::string error;
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("OFF/ON"), std::string::npos) << error;
+}
+
 TEST(EventResidual, CreateUsesFixedSizeAutoDiffForOneStep) {
   const std::unique_ptr<ceres::CostFunction> one_step(
       EventResidual::Create(1.0, 1, LinearParams(5.0)));

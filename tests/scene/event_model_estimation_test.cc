@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
+#include "events/simulator.h"
 #include "tests/scene/scene_test_scenes.h"
 
 namespace evfs {
@@ -25,6 +28,38 @@ TEST(EventModelEstimation, MeasuresTheSimulatorsThresholdWithTheLogModel) {
               kThresholdTolerance);
   EXPECT_DOUBLE_EQ(estimate.alpha, options.alpha_times_change / estimate.change_per_event);
   EXPECT_NE(estimate.description.find("measured"), std::string::npos);
+}
+
+// A sensor whose OFF threshold is lower than its ON one (as a DAVIS's are): measured per
+// polarity, the change of one ON event and of one OFF event are the two thresholds, and their
+// ratio becomes the OFF slope; measured together they give one value between them.
+TEST(EventModelEstimation, MeasuresOnAndOffThresholdsApart) {
+  const test::SyntheticRecording recording(64, 48, 0.03, 5);
+  SimulatorOptions sensor;
+  sensor.contrast_threshold_pos = 0.3;
+  sensor.contrast_threshold_neg = 0.15;
+  const EventStream events = SimulateEvents(recording.rendered, sensor);
+  const Scene scene =
+      MakeInterpolationScene(recording.Sharp(0), recording.Sharp(30), events, BinningOptions());
+  EventModelParams log_model;
+  log_model.model = EventModel::kLog;
+  log_model.log_offset = sensor.log_eps;
+  EventModelEstimationOptions options;
+  options.min_pixels = 20;
+  const EventModelEstimate estimate = EstimateEventModel(scene, log_model, options);
+  ASSERT_TRUE(estimate.estimated_from_frames);
+  // Each median is biased by a pixel's rounding (a change between n and n + 1 thresholds gives
+  // n events) by up to a third here; the ratio of the two is what the model takes.
+  EXPECT_NEAR(estimate.change_per_event, 0.3, 0.3 * 0.35);
+  EXPECT_NEAR(estimate.change_per_event / estimate.off_alpha_ratio, 0.15, 0.15 * 0.35);
+  EXPECT_NEAR(estimate.off_alpha_ratio, 2.0, 2.0 * 0.2);
+  EXPECT_NE(estimate.description.find("OFF"), std::string::npos) << estimate.description;
+
+  options.per_polarity = false;
+  const EventModelEstimate together = EstimateEventModel(scene, log_model, options);
+  EXPECT_EQ(together.off_alpha_ratio, 1.0);
+  EXPECT_GT(together.change_per_event, 0.15 * 0.9);
+  EXPECT_LT(together.change_per_event, 0.3 * 1.1);
 }
 
 TEST(EventModelEstimation, FallsBackToTheAssumedChangeWithOneFrame) {

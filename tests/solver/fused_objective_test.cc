@@ -221,6 +221,17 @@ TEST(FusedObjective, MatchesTheProblemOverMergedSegments) {
   }
 }
 
+TEST(FusedObjective, MatchesTheProblemWithAnOffSlope) {
+  // Darkening steps with their own α (EventModelParams::off_alpha_ratio), both event models.
+  for (const EventModel model : {EventModel::kLinear, EventModel::kLog}) {
+    const Scene scene = MakeRandomScene(Binning::kCollision, Activity::kPartial, 41);
+    ReconstructionOptions options = MakeOptions(SpatialTv::kAnisotropic, model, Activity::kPartial);
+    options.objective.event_model.off_alpha_ratio = 1.7;
+    SCOPED_TRACE(EventModelName(model));
+    ExpectFusedMatchesCeres(scene, options, MakeRandomLatent(42), /*num_threads=*/2);
+  }
+}
+
 // The true-ℓ1 objective from Ceres' own residuals and Jacobian (no loss applied): cost
 // Σ w_i |r_i| and gradient Σ w_i sign(r_i) ∂r_i/∂H (for isotropic TV, the norm of the block's
 // two residuals and w r / ‖r‖).
