@@ -66,14 +66,14 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
   const BinningPlan plan = PlanBinning(window, begin_ns, end_ns, binning);
   const PixelActivity& activity = plan.activity;
   const size_t positive = window.CountPositive();
-  std::string hot;
+  std::string left_out;  // what the binning leaves out
   if (!activity.hot_pixels.empty()) {
-    hot = " without " + std::to_string(activity.hot_pixels.size()) + " hot pixel" +
-          (activity.hot_pixels.size() == 1 ? "" : "s") + " (" +
-          std::to_string(activity.hot_pixel_events) + " events left out)";
+    left_out = " without " + std::to_string(activity.hot_pixels.size()) + " hot pixel" +
+               (activity.hot_pixels.size() == 1 ? "" : "s") + " (" +
+               std::to_string(activity.hot_pixel_events) + " events left out)";
   }
   if (plan.noise_events > 0) {
-    hot += ", " + std::to_string(plan.noise_events) + " unsupported events left out as noise";
+    left_out += ", " + std::to_string(plan.noise_events) + " unsupported events left out as noise";
   }
   std::fprintf(
       out,
@@ -82,7 +82,7 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
       first, last, NanosecondsToSeconds(end_ns - begin_ns), window.size(), positive,
       window.size() - positive, static_cast<long long>(activity.pixels_fired),
       100.0 * static_cast<double>(activity.pixels_fired) / static_cast<double>(plan.pixels),
-      static_cast<long long>(plan.collision_frames), hot.c_str());
+      static_cast<long long>(plan.collision_frames), left_out.c_str());
   std::fprintf(out, "binning     %s: %s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
                binning_flag.c_str(), NameOf(kBinningMethodNames, plan.method),
                plan.num_event_frames, plan.num_latent_frames,

@@ -103,13 +103,12 @@ class EventResidualAnalytic : public ceres::SizedCostFunction<1, 1, 1> {
                 double** jacobians) const override {
     const double intensity_before = parameters[0][0];
     const double intensity_after = parameters[1][0];
-    const double predicted_event =
-        PredictedEvent(intensity_before, intensity_after, params_, saturation_);
+    const double change = IntensityTransform(intensity_after, params_) -
+                          IntensityTransform(intensity_before, params_);
+    const double predicted_event = PredictedEventForChange(change, params_, saturation_);
     residuals[0] = event_value_ - predicted_event;
     if (jacobians == nullptr) return true;
     const double u = predicted_event / saturation_;
-    const double change = IntensityTransform(intensity_after, params_) -
-                          IntensityTransform(intensity_before, params_);
     const double slope = params_.AlphaFor(change) * (1.0 - u * u);
     if (jacobians[0] != nullptr) {
       jacobians[0][0] = slope * IntensityTransformDerivative(intensity_before, params_);

@@ -1,5 +1,6 @@
 #include "events/noise_filter.h"
 
+#include <algorithm>
 #include <limits>
 #include <vector>
 
@@ -7,6 +8,19 @@ namespace evfs {
 namespace {
 
 constexpr int64_t kNever = std::numeric_limits<int64_t>::min() / 2;
+
+// True when one of the 8 neighbours of (x, y) has its time in `last` within window_ns before t.
+bool NeighbourFiredWithin(const std::vector<int64_t>& last, int width, int height, int x, int y,
+                          int64_t t, int64_t window_ns) {
+  for (int qy = std::max(y - 1, 0); qy <= std::min(y + 1, height - 1); ++qy) {
+    for (int qx = std::max(x - 1, 0); qx <= std::min(x + 1, width - 1); ++qx) {
+      if ((qx != x || qy != y) && t - last[static_cast<size_t>(qy) * width + qx] <= window_ns) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
 
 // One pass over the events in the order `order` (+1: forward in time, -1: backward). Marks in
 // *supported the events for which a neighbour fired within window_ns on the side already
@@ -25,18 +39,7 @@ void MarkSupport(const EventStream& events, int64_t window_ns, int order,
     if (x >= width || y >= height) continue;
     const int64_t t = order > 0 ? events.t_ns(i) : -events.t_ns(i);
     if (!(*supported)[i]) {
-      for (int dy = -1; dy <= 1 && !(*supported)[i]; ++dy) {
-        const int qy = y + dy;
-        if (qy < 0 || qy >= height) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = x + dx;
-          if ((dx == 0 && dy == 0) || qx < 0 || qx >= width) continue;
-          if (t - last[static_cast<size_t>(qy) * width + qx] <= window_ns) {
-            (*supported)[i] = 1;
-            break;
-          }
-        }
-      }
+      (*supported)[i] = NeighbourFiredWithin(last, width, height, x, y, t, window_ns);
     }
     last[static_cast<size_t>(y) * width + x] = t;
   }

@@ -102,6 +102,13 @@ inline double IntensityTransformDerivative(double intensity, const EventModelPar
   return intensity >= 0.0 ? 1.0 / (intensity + params.log_offset) : 0.0;
 }
 
+/// PredictedEvent of a step whose change of g is `change`: c tanh(AlphaFor(change) change / c).
+template <typename T>
+T PredictedEventForChange(const T& change, const EventModelParams& params, double saturation) {
+  using std::tanh;
+  return saturation * tanh(params.AlphaFor(change) * change / saturation);
+}
+
 /// Predicted event value of one latent step: c tanh(alpha (g(after) - g(before)) / c), with
 /// params.AlphaFor the change (the OFF slope for a darkening step).
 ///
@@ -113,10 +120,9 @@ inline double IntensityTransformDerivative(double intensity, const EventModelPar
 template <typename T>
 T PredictedEvent(const T& intensity_before, const T& intensity_after,
                  const EventModelParams& params, double saturation = 1.0) {
-  using std::tanh;
-  const T change =
-      IntensityTransform(intensity_after, params) - IntensityTransform(intensity_before, params);
-  return saturation * tanh(params.AlphaFor(change) * change / saturation);
+  return PredictedEventForChange(
+      IntensityTransform(intensity_after, params) - IntensityTransform(intensity_before, params),
+      params, saturation);
 }
 
 /// c of PredictedEvent for an event frame holding `event_value` over `num_steps` steps: the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 #include <vector>
 
 #include "core/option_checker.h"
@@ -73,8 +74,9 @@ EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams
         change = Median(per_on_event);
         change_off = Median(per_off_event);
       } else {
-        per_on_event.insert(per_on_event.end(), per_off_event.begin(), per_off_event.end());
-        change = Median(per_on_event);
+        std::vector<double> per_event = std::move(per_on_event);
+        per_event.insert(per_event.end(), per_off_event.begin(), per_off_event.end());
+        change = Median(std::move(per_event));
       }
     }
   }
