@@ -90,6 +90,7 @@ ProgramHelp MakeEvfsHelp() {
       {"bounds", "model", "reconstruct video"},
       {"activity_radius_px", "model", "reconstruct video"},
       {"merge_quiet_steps", "model", "reconstruct video"},
+      {"unfired_pixel_changes", "model", "reconstruct video"},
       {"split_independent_parts", "model", "reconstruct video"},
       {"max_problem_mb", "model", "reconstruct video"},
       {"blend_quiet_pixels", "model", "reconstruct video"},

@@ -162,6 +162,10 @@ DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
             "Hold a pixel "
             "constant between the latent steps where it fired (one unknown per quiet run); "
             "false: one unknown per voxel.");
+DEFINE_bool(unfired_pixel_changes, evfs::ReconstructionOptions().unfired_pixel_changes,
+            "With merged quiet steps, a pixel near the events that never fires gets one change "
+            "after the last frame, at the median of its neighbours' events (false: it stays "
+            "constant).");
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "Solve the regions that no term couples as separate problems, concurrently "
             "(one after another with --progress or --checkpoints); false: one problem.");
@@ -388,6 +392,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   options.bound_intensities = FLAGS_bounds;
   options.activity_radius_px = FLAGS_activity_radius_px;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
+  options.unfired_pixel_changes = FLAGS_unfired_pixel_changes;
   options.split_independent_parts = FLAGS_split_independent_parts;
   options.max_problem_mb = FLAGS_max_problem_mb;
   options.blend_quiet_pixels = FLAGS_blend_quiet_pixels;

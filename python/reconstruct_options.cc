@@ -199,6 +199,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       BoolOption<R>("bounds", [](R& s) -> bool& { return Rec(s).bound_intensities; }),
       IntOption<R>("activity_radius_px", [](R& s) -> int& { return Rec(s).activity_radius_px; }),
       BoolOption<R>("merge_quiet_steps", [](R& s) -> bool& { return Rec(s).merge_quiet_steps; }),
+      BoolOption<R>("unfired_pixel_changes",
+                    [](R& s) -> bool& { return Rec(s).unfired_pixel_changes; }),
       BoolOption<R>("split_independent_parts",
                     [](R& s) -> bool& { return Rec(s).split_independent_parts; }),
       IntOption<R>("max_problem_mb", [](R& s) -> int64_t& { return Rec(s).max_problem_mb; }),

@@ -1,13 +1,71 @@
 #include "solver/latent_layout.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "core/error.h"
 
 namespace evfs {
+namespace {
+
+// Start marks of LatentLayout's segment starts (t >= 1).
+constexpr uint8_t kContinues = 0, kStarts = 1, kStartsUnfiredChange = 2;
+
+// Fewest events at an unfired pixel's 8 neighbours after the last frame for it to change: one
+// event is as likely noise. Measured: README, "The model and its defaults".
+constexpr float kMinNeighbourEvents = 2.0f;
+
+// The event frame at which each unfired active pixel changes (latent_layout.h), or -1: the
+// frame holding the median of its 8 neighbours' events after the last frame observation.
+std::vector<int> UnfiredChangeFrames(const Scene& scene, const ActivityMask& mask) {
+  const int width = scene.width, height = scene.height;
+  const int64_t pixels = static_cast<int64_t>(width) * height;
+  int last_frame_latent = 0;
+  for (const FrameObservation& frame : scene.frames) {
+    last_frame_latent = std::max(last_frame_latent, frame.latent_last);
+  }
+  std::vector<uint8_t> fired(pixels, 0);
+  for (int k = 0; k < scene.events.num_frames(); ++k) {
+    const float* values = scene.events.frame_data(k);
+    for (int64_t p = 0; p < pixels; ++p) fired[p] |= values[p] != 0.0f;
+  }
+  // Calls visit(k, q, n) for the n events of event frame k (after the last frame) at each
+  // neighbour of every unfired active pixel q.
+  const auto for_each_neighbour_event = [&](const auto& visit) {
+    for (int k = 0; k < scene.events.num_frames(); ++k) {
+      if (scene.events.span(k).latent_first < last_frame_latent) continue;
+      const float* values = scene.events.frame_data(k);
+      for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+          const float count = std::abs(values[static_cast<int64_t>(y) * width + x]);
+          if (count == 0.0f) continue;
+          for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny) {
+            for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
+              const int64_t q = static_cast<int64_t>(ny) * width + nx;
+              if (!fired[q] && mask.active(q)) visit(k, q, count);
+            }
+          }
+        }
+      }
+    }
+  };
+  std::vector<double> total(pixels, 0.0);
+  for_each_neighbour_event([&](int, int64_t q, float count) { total[q] += count; });
+  std::vector<double> seen(pixels, 0.0);
+  std::vector<int> change_frame(pixels, -1);
+  for_each_neighbour_event([&](int k, int64_t q, float count) {
+    if (change_frame[q] >= 0 || total[q] < kMinNeighbourEvents) return;
+    seen[q] += count;
+    if (seen[q] > total[q] / 2.0) change_frame[q] = k;
+  });
+  return change_frame;
+}
+
+}  // namespace
 
 LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const Video& initial,
-                           bool merge_quiet_steps)
+                           bool merge_quiet_steps, bool unfired_changes)
     : num_latent_frames_(scene.num_latent_frames()),
       pixels_per_frame_(static_cast<int64_t>(scene.height) * scene.width) {
   const int num_latent = num_latent_frames_;
@@ -22,14 +80,27 @@ LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const V
   }
 
   // starts[t * pixels + p]: H_t(p) begins a new segment (t >= 1).
-  std::vector<uint8_t> starts(static_cast<size_t>(num_latent) * pixels, merge_quiet_steps ? 0 : 1);
+  std::vector<uint8_t> starts(static_cast<size_t>(num_latent) * pixels,
+                              merge_quiet_steps ? kContinues : kStarts);
   if (merge_quiet_steps) {
     for (int k = 0; k < scene.events.num_frames(); ++k) {
       const EventFrameSpan& span = scene.events.span(k);
       const float* values = scene.events.frame_data(k);
       for (int64_t p = 0; p < pixels; ++p) {
         if (values[p] == 0.0f || !mask.active(p)) continue;
-        for (int t = span.latent_first + 1; t <= span.latent_last; ++t) starts[t * pixels + p] = 1;
+        for (int t = span.latent_first + 1; t <= span.latent_last; ++t) {
+          starts[t * pixels + p] = kStarts;
+        }
+      }
+    }
+    if (unfired_changes) {
+      const std::vector<int> change_frame = UnfiredChangeFrames(scene, mask);
+      for (int64_t p = 0; p < pixels; ++p) {
+        if (change_frame[p] < 0) continue;
+        const EventFrameSpan& span = scene.events.span(change_frame[p]);
+        for (int t = span.latent_first + 1; t <= span.latent_last; ++t) {
+          starts[t * pixels + p] = kStartsUnfiredChange;
+        }
       }
     }
     for (int t = 1; t < num_latent; ++t) {
@@ -37,7 +108,7 @@ LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const V
       const double* before = initial.frame_data(t - 1);
       for (int64_t p = 0; p < pixels; ++p) {
         if (mask.role(p) == ActivityMask::Role::kRing && now[p] != before[p]) {
-          starts[t * pixels + p] = 1;
+          starts[t * pixels + p] = kStarts;
         }
       }
     }
@@ -50,10 +121,11 @@ LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const V
     segment.pixel = p;
     segment.constant = !mask.active(p);
     for (int t = 0; t < num_latent; ++t) {
-      if (t > 0 && starts[t * pixels + p]) {
+      if (t > 0 && starts[t * pixels + p] != kContinues) {
         segment.last = t - 1;
         segments_.push_back(segment);
         segment.first = t;
+        segment.unfired_change = starts[t * pixels + p] == kStartsUnfiredChange;
       }
       segment_of_voxel_[t * pixels + p] = static_cast<int32_t>(segments_.size());
     }

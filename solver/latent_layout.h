@@ -12,6 +12,15 @@
 // problem keeps the pixel constant there anyway. On slider_depth the merged layout has about a
 // tenth of the unknowns, which is what the solve time follows.
 //
+// An active pixel that never fires is one segment, one constant over the window. Between two
+// frames the frame terms pin it; after the last frame nothing does, and a constant cannot
+// follow the motion its neighbours report. With `unfired_changes`, such a pixel whose 8
+// neighbours hold at least two events after the last frame gets one change: a new segment at
+// the event frame holding the median of those events (all of that frame's steps, so that an
+// event frame stays all new segments or none). The change has no event residual (the pixel
+// did not fire: it stayed under a threshold, which says little about its size); the temporal
+// and spatial TV price it.
+//
 // Storage: a segment's value lives in the latent Video, in the voxel of its first frame, so
 // a ceres::Problem over segments is a problem over voxels of that Video. Expand() copies each
 // value to the rest of its segment after a solve.
@@ -34,14 +43,17 @@ class LatentLayout {
     int first = 0;          // first latent frame
     int last = 0;           // last latent frame (inclusive)
     bool constant = false;  // a ring pixel's segment: held at its initial value
+    /// The segment begins with an unfired pixel's change (no event residual there).
+    bool unfired_change = false;
     int length() const { return last - first + 1; }
   };
 
   /// Segments for every pixel the mask puts in the problem. With `merge_quiet_steps` false every
   /// voxel is its own segment (the plain per-voxel layout). `initial` is the initial latent video
-  /// (for ring pixels' constants).
+  /// (for ring pixels' constants). `unfired_changes` (merged layout only): unfired pixels next to
+  /// events after the last frame get one change (above).
   LatentLayout(const Scene& scene, const ActivityMask& mask, const Video& initial,
-               bool merge_quiet_steps);
+               bool merge_quiet_steps, bool unfired_changes = false);
 
   int num_latent_frames() const { return num_latent_frames_; }
   int64_t pixels_per_frame() const { return pixels_per_frame_; }

@@ -95,8 +95,8 @@ ProblemPlan ProblemBuilder::Prepare(Video* latent) const {
   }
   ProblemPlan prepared;
   prepared.mask_ = std::make_shared<ActivityMask>(scene_.events, options_.activity_radius_px);
-  auto layout =
-      std::make_shared<LatentLayout>(scene_, *prepared.mask_, *latent, options_.merge_quiet_steps);
+  auto layout = std::make_shared<LatentLayout>(
+      scene_, *prepared.mask_, *latent, options_.merge_quiet_steps, options_.unfired_pixel_changes);
   layout->ProjectOnto(latent);
   prepared.layout_ = std::move(layout);
   prepared.terms_ = std::make_shared<ObjectiveTerms>(scene_, options_.objective, *prepared.mask_);
@@ -347,6 +347,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
         }
         if (new_segments == 0) continue;
         CHECK_EQ(new_segments, steps) << "an event frame's span is partly merged";
+        // An unfired pixel's change has no event residual (LatentLayout).
+        if (layout.segment(layout.segment_at(span.latent_last, p)).unfired_change) continue;
         const double value = values[p];
         ceres::CostFunction* cost = cache.Get(Family::kEvent, value, {steps}, [&] {
           return EventResidual::Create(value, steps, objective.event_model);

@@ -82,6 +82,12 @@ struct ReconstructionOptions {
   /// changes and the problem is several times smaller). False: one unknown per voxel.
   bool merge_quiet_steps = true;
 
+  /// With merged quiet steps, an active pixel that never fires but whose neighbours do after
+  /// the last frame gets one change, at the median of their events (LatentLayout), instead of
+  /// staying one constant that nothing after the last frame pins. Measured: README, "The model
+  /// and its defaults".
+  bool unfired_pixel_changes = true;
+
   /// Solve separately, on solver.num_threads threads, the parts of the scene that no term
   /// couples (ActivityMask::IndependentParts): each stops at its own convergence and the
   /// threads share the work. With an iteration callback the parts are solved one after another

@@ -138,6 +138,58 @@ TEST(ProblemBuilder, MergedLayoutHasOneUnknownPerQuietRun) {
   EXPECT_NEAR(latent.at(2, 2, 3), 0.6 - 0.4 / 6.0, 1e-12);
 }
 
+// Prediction (one frame, at latent frame 0) on a 5×6 scene: (2, 2) fires at steps 0 and 2,
+// (2, 3) at step 2. An unfired pixel with at least two events at its 8 neighbours changes once,
+// at the event frame of their median; with one (or none) it stays one constant; the change has
+// no event residual.
+TEST(ProblemBuilder, UnfiredPixelsChangeOnceWhereTheirNeighboursFireAfterTheLastFrame) {
+  Scene scene = MakeSceneWithEvents(5, 6, {{0, 2, 2}, {2, 2, 2}, {2, 2, 3}});
+  scene.frames.pop_back();
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  options.activity_radius_px = -1;
+  const auto pixel = [&](int y, int x) { return static_cast<int64_t>(y) * scene.width + x; };
+
+  Video latent = InitializeLatentVideo(scene);
+  const auto built = ProblemBuilder(scene, options).Build(&latent);
+  const LatentLayout& layout = built->layout();
+  // Segments of pixel p: the latent frames where one starts.
+  const auto starts = [&](const LatentLayout& of, int64_t p) {
+    std::vector<int> frames;
+    for (int t = 1; t < scene.num_latent_frames(); ++t) {
+      if (of.segment_at(t, p) != of.segment_at(t - 1, p)) frames.push_back(t);
+    }
+    return frames;
+  };
+  // (1, 2) sees steps 0, 2, 2 (median 2); (1, 1) steps 0, 2 (median: the second, 2).
+  EXPECT_EQ(starts(layout, pixel(1, 2)), std::vector<int>{3});
+  EXPECT_TRUE(layout.segment(layout.segment_at(3, pixel(1, 2))).unfired_change);
+  EXPECT_EQ(starts(layout, pixel(1, 1)), std::vector<int>{3});
+  EXPECT_EQ(starts(layout, pixel(3, 3)), std::vector<int>{3});
+  // One event next to it, or none: constant.
+  EXPECT_TRUE(starts(layout, pixel(1, 4)).empty());
+  EXPECT_TRUE(starts(layout, pixel(0, 0)).empty());
+  // The pixels that fired keep their own segments, not flagged.
+  EXPECT_EQ(starts(layout, pixel(2, 2)), (std::vector<int>{1, 3}));
+  EXPECT_FALSE(layout.segment(layout.segment_at(3, pixel(2, 2))).unfired_change);
+  EXPECT_EQ(built->statistics().event_residuals, 3);
+
+  options.unfired_pixel_changes = false;
+  Video constant_latent = InitializeLatentVideo(scene);
+  const auto constant = ProblemBuilder(scene, options).Build(&constant_latent);
+  EXPECT_TRUE(starts(constant->layout(), pixel(1, 2)).empty());
+  EXPECT_EQ(constant->statistics().event_residuals, 3);
+  EXPECT_LT(constant->statistics().variable_parameter_blocks,
+            built->statistics().variable_parameter_blocks);
+
+  // A frame at the end pins every pixel: no change.
+  options.unfired_pixel_changes = true;
+  const Scene interpolation = MakeSceneWithEvents(5, 6, {{0, 2, 2}, {2, 2, 2}, {2, 2, 3}});
+  Video pinned_latent = InitializeLatentVideo(interpolation);
+  const auto pinned = ProblemBuilder(interpolation, options).Build(&pinned_latent);
+  EXPECT_TRUE(starts(pinned->layout(), pixel(1, 2)).empty());
+}
+
 TEST(ActivityMask, IndependentPartsAreConnectedRegionsOfTheProblem) {
   // Radius 1: events at (y 2, x 2) and (y 2, x 5) give active squares whose rings touch (one
   // region); the event at (y 2, x 14) is far from both (a second region).
@@ -240,6 +292,9 @@ TEST(ProblemBuilder, MergedProblemIsTheFullProblemOnSegmentConstantVideos) {
                 recording.rendered.timestamp_ns(12) + 1, BinningOptions());
   ReconstructionOptions options;
   options.objective.event_model.alpha = 8.0;
+  // An unfired pixel's change has no event residual, by design a different objective (tested
+  // in UnfiredPixelsChangeOnce...): compare the plain merge.
+  options.unfired_pixel_changes = false;
   Video merged_video = InitializeLatentVideo(scene);
   const auto merged = ProblemBuilder(scene, options).Build(&merged_video);
   const LatentLayout& layout = merged->layout();
