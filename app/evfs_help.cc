@@ -93,7 +93,7 @@ ProgramHelp MakeEvfsHelp() {
       {"unfired_pixel_changes", "model", "reconstruct video"},
       {"split_independent_parts", "model", "reconstruct video"},
       {"max_problem_mb", "model", "reconstruct video"},
-      {"blend_quiet_pixels", "model", "reconstruct video"},
+      {"quiet_blend_fraction", "model", "reconstruct video"},
       // Ceres.
       {"linear_solver", "solver", "reconstruct video"},
       {"preconditioner", "solver", "reconstruct video"},

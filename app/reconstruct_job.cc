@@ -343,6 +343,7 @@ void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& p
       {"activity_radius_px", options.activity_radius_px},
       {"merge_quiet_steps", options.merge_quiet_steps},
       {"unfired_pixel_changes", options.unfired_pixel_changes},
+      {"quiet_blend_fraction", Number(options.quiet_blend_fraction)},
   };
   Json continuation = Json::array();
   for (const double scale : options.smoothing_continuation) continuation.push_back(Number(scale));

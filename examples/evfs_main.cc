@@ -169,9 +169,10 @@ DEFINE_bool(unfired_pixel_changes, evfs::ReconstructionOptions().unfired_pixel_c
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "Solve the regions that no term couples as separate problems, concurrently "
             "(one after another with --progress or --checkpoints); false: one problem.");
-DEFINE_bool(blend_quiet_pixels, evfs::ReconstructionOptions().blend_quiet_pixels,
-            "After the solve, pixels no event fired whose sharp frames differ by less than one "
-            "event's change take the time-weighted blend of the frames between them.");
+DEFINE_double(quiet_blend_fraction, evfs::ReconstructionOptions().quiet_blend_fraction,
+              "After the solve, pixels no event fired whose sharp frames differ by less than "
+              "this fraction of one event's change take the time-weighted blend of the frames "
+              "between them; 0: off.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once, estimated before building: "
              "larger problems are solved in batches of parts, or in overlapping bands of rows, "
@@ -395,7 +396,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   options.unfired_pixel_changes = FLAGS_unfired_pixel_changes;
   options.split_independent_parts = FLAGS_split_independent_parts;
   options.max_problem_mb = FLAGS_max_problem_mb;
-  options.blend_quiet_pixels = FLAGS_blend_quiet_pixels;
+  options.quiet_blend_fraction = FLAGS_quiet_blend_fraction;
   options.smoothing_continuation =
       ParseNumberList(FLAGS_smoothing_continuation, "--smoothing_continuation");
 

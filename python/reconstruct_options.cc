@@ -204,7 +204,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       BoolOption<R>("split_independent_parts",
                     [](R& s) -> bool& { return Rec(s).split_independent_parts; }),
       IntOption<R>("max_problem_mb", [](R& s) -> int64_t& { return Rec(s).max_problem_mb; }),
-      BoolOption<R>("blend_quiet_pixels", [](R& s) -> bool& { return Rec(s).blend_quiet_pixels; }),
+      DoubleOption<R>("quiet_blend_fraction",
+                      [](R& s) -> double& { return Rec(s).quiet_blend_fraction; }),
       // Ceres.
       {"linear_solver",
        [](const R& s) {

@@ -113,11 +113,14 @@ struct ReconstructionOptions {
   int64_t max_problem_mb = 384;
 
   /// After the solve, a pixel that no event fired and whose consecutive sharp frames differ by
-  /// less than one event's change (in the event model's g) takes the time-weighted blend of
-  /// the two between them: no event says its change stayed below the threshold, and the blend
-  /// meets both frames, where the solve holds such a pixel constant at a value the ℓ1 frame
-  /// terms leave undecided. Off by default: BENCHMARKS.md, "Quiet scenes".
-  bool blend_quiet_pixels = false;
+  /// less than this fraction of one event's change (in the event model's g) takes the
+  /// time-weighted blend of the two between them: no event says its change stayed below the
+  /// threshold, and the blend meets both frames, where the solve holds such a pixel constant at
+  /// a value the ℓ1 frame terms leave undecided. 0: off (the default: at 0.5 it passes more
+  /// quiet windows but costs two clips' interpolations 0.06 dB; sweep: BENCHMARKS.md, "Quiet
+  /// scenes"). Not applied with a prior (objective.prior_weight).
+  double quiet_blend_fraction = 0.0;
+  static constexpr double kMaxQuietBlendFraction = 100.0;
   static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;
 
   /// Ceres settings, all of them available to library users; the defaults below are set by

@@ -104,9 +104,9 @@ double InitialCost(ceres::Problem* problem) {
   return cost;
 }
 
-// ReconstructionOptions::blend_quiet_pixels.
+// ReconstructionOptions::quiet_blend_fraction: `largest_change` is that fraction of one event's.
 void BlendQuietPixels(const Scene& scene, const EventModelParams& event_model,
-                      double change_per_event, Video* latent) {
+                      double largest_change, Video* latent) {
   std::vector<const FrameObservation*> sharp;
   for (const FrameObservation& frame : scene.frames) {
     if (frame.latent_first == frame.latent_last) sharp.push_back(&frame);
@@ -130,7 +130,7 @@ void BlendQuietPixels(const Scene& scene, const EventModelParams& event_model,
     }
     for (int64_t p = 0; p < pixels; ++p) {
       if (fired[p] || std::abs(IntensityTransform(last[p], event_model) -
-                               IntensityTransform(first[p], event_model)) >= change_per_event) {
+                               IntensityTransform(first[p], event_model)) >= largest_change) {
         continue;
       }
       for (int t = a; t <= b; ++t) {
@@ -319,9 +319,11 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     BuildAndSolve(scene, stage, callback, &result);
     if (!summary.solved) break;  // nothing to solve
   }
-  if (options.blend_quiet_pixels && summary.solved) {
-    BlendQuietPixels(scene, solve_options.objective.event_model, summary.model.change_per_event,
-                     &result.video);
+  // With a prior (plug & play's x-update) the solve's answer is the minimiser it asked for.
+  if (options.quiet_blend_fraction > 0.0 && options.objective.prior_weight == 0.0 &&
+      summary.solved) {
+    BlendQuietPixels(scene, solve_options.objective.event_model,
+                     options.quiet_blend_fraction * summary.model.change_per_event, &result.video);
   }
   return result;
 }

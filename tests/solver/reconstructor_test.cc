@@ -316,20 +316,32 @@ TEST(Reconstructor, QuietPixelsTakeTheBlendOfTheFrames) {
   scene.frames[0].image = Image::Constant(6, 8, 0.40);
   scene.frames[1].image = Image::Constant(6, 8, 0.42);
   scene.frames[1].image(3, 5) = 0.9;  // unfired, but a change of many events
+  // Unfired, a change of 0.15 in g = log(x + 0.5): 3/4 of one event's (1/α = 0.2).
+  const double three_quarters = 0.9 * std::exp(0.15) - 0.5;
+  scene.frames[1].image(4, 6) = three_quarters;
   ReconstructionOptions options;
   options.objective.event_model.alpha = 5.0;
   options.activity_radius_px = -1;
+  options.quiet_blend_fraction = 0.0;
   const Reconstruction solved = Reconstruct(scene, options);
-  options.blend_quiet_pixels = true;
-  const Reconstruction blended = Reconstruct(scene, options);
-  ASSERT_TRUE(blended.summary.solved);
+  options.quiet_blend_fraction = 0.5;
+  const Reconstruction half = Reconstruct(scene, options);
+  options.quiet_blend_fraction = 1.0;
+  const Reconstruction whole = Reconstruct(scene, options);
+  ASSERT_TRUE(half.summary.solved);
   const auto& times = scene.latent_timestamps_ns();
   for (int t = 0; t < scene.num_latent_frames(); ++t) {
     const double w = static_cast<double>(times[t] - times[0]) / (times.back() - times[0]);
-    EXPECT_NEAR(blended.video.frame(t)(0, 0), (1.0 - w) * 0.40 + w * 0.42, 1e-12) << t;
-    EXPECT_EQ(blended.video.frame(t)(2, 2), solved.video.frame(t)(2, 2)) << t;
-    EXPECT_EQ(blended.video.frame(t)(3, 5), solved.video.frame(t)(3, 5)) << t;
+    for (const Reconstruction* blended : {&half, &whole}) {
+      EXPECT_NEAR(blended->video.frame(t)(0, 0), (1.0 - w) * 0.40 + w * 0.42, 1e-12) << t;
+      EXPECT_EQ(blended->video.frame(t)(2, 2), solved.video.frame(t)(2, 2)) << t;
+      EXPECT_EQ(blended->video.frame(t)(3, 5), solved.video.frame(t)(3, 5)) << t;
+    }
+    // Under one event's change but over half of it: blended only with the whole fraction.
+    EXPECT_EQ(half.video.frame(t)(4, 6), solved.video.frame(t)(4, 6)) << t;
+    EXPECT_NEAR(whole.video.frame(t)(4, 6), (1.0 - w) * 0.40 + w * three_quarters, 1e-12) << t;
   }
+  EXPECT_NE(solved.video.frame(1)(0, 0), half.video.frame(1)(0, 0));
 }
 
 }  // namespace
