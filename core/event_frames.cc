@@ -16,4 +16,14 @@ double EventFrames::TotalAbsoluteValue() const {
   return total;
 }
 
+std::vector<uint8_t> EventFrames::FiredPixels() const {
+  const int64_t pixels = pixels_per_frame();
+  std::vector<uint8_t> fired(pixels, 0);
+  for (int k = 0; k < num_frames(); ++k) {
+    const float* values = frame_data(k);
+    for (int64_t p = 0; p < pixels; ++p) fired[p] |= values[p] != 0.0f;
+  }
+  return fired;
+}
+
 }  // namespace evfs

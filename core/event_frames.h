@@ -54,6 +54,8 @@ class EventFrames {
 
   /// Sum over frames of |value| (the number of events for collision frames).
   double TotalAbsoluteValue() const;
+  /// Per pixel (row-major), 1 where some frame holds a non-zero value, else 0.
+  std::vector<uint8_t> FiredPixels() const;
 
  private:
   size_t Index(int k, int y, int x) const {

@@ -43,12 +43,7 @@ ActivityMask::ActivityMask(const EventFrames& events, int radius_px)
     num_active_ = pixels;
     return;
   }
-  std::vector<uint8_t> fired(pixels, 0);
-  for (int k = 0; k < events.num_frames(); ++k) {
-    const float* values = events.frame_data(k);
-    for (int64_t p = 0; p < pixels; ++p) fired[p] |= values[p] != 0.0f;
-  }
-  const std::vector<uint8_t> active = Dilate(fired, height, width, radius_px);
+  const std::vector<uint8_t> active = Dilate(events.FiredPixels(), height, width, radius_px);
   const std::vector<uint8_t> near_active = Dilate(active, height, width, 1);
   roles_.resize(pixels);
   for (int64_t p = 0; p < pixels; ++p) {

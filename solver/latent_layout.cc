@@ -25,11 +25,7 @@ std::vector<int> UnfiredChangeFrames(const Scene& scene, const ActivityMask& mas
   for (const FrameObservation& frame : scene.frames) {
     last_frame_latent = std::max(last_frame_latent, frame.latent_last);
   }
-  std::vector<uint8_t> fired(pixels, 0);
-  for (int k = 0; k < scene.events.num_frames(); ++k) {
-    const float* values = scene.events.frame_data(k);
-    for (int64_t p = 0; p < pixels; ++p) fired[p] |= values[p] != 0.0f;
-  }
+  const std::vector<uint8_t> fired = scene.events.FiredPixels();
   // Calls visit(k, q, n) for the n events of event frame k (after the last frame) at each
   // neighbour of every unfired active pixel q.
   const auto for_each_neighbour_event = [&](const auto& visit) {

@@ -114,11 +114,7 @@ void BlendQuietPixels(const Scene& scene, const EventModelParams& event_model,
   std::sort(sharp.begin(), sharp.end(),
             [](const auto* a, const auto* b) { return a->latent_first < b->latent_first; });
   const int64_t pixels = latent->pixels_per_frame();
-  std::vector<uint8_t> fired(pixels, 0);
-  for (int k = 0; k < scene.events.num_frames(); ++k) {
-    const float* values = scene.events.frame_data(k);
-    for (int64_t p = 0; p < pixels; ++p) fired[p] |= values[p] != 0.0f;
-  }
+  const std::vector<uint8_t> fired = scene.events.FiredPixels();
   const std::vector<int64_t>& times = scene.latent_timestamps_ns();
   for (size_t j = 0; j + 1 < sharp.size(); ++j) {
     const int a = sharp[j]->latent_first, b = sharp[j + 1]->latent_first;
