@@ -55,6 +55,9 @@ DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_indepen
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once; <= 0: no limit.");
 DEFINE_string(init, "blend", "blend | events: where the solve starts.");
+DEFINE_bool(whole_objective, false,
+            "after each clip solve, print to stderr the objective of its answer evaluated as one "
+            "problem (no memory budget), to compare a banded solve with the whole one");
 DEFINE_int32(clip_crop_px, 0, "Keep the central N x N pixels of each clip (0: whole frames).");
 DEFINE_int32(max_iterations, evfs::ReconstructionOptions().solver.max_num_iterations,
              "most Levenberg-Marquardt iterations.");
@@ -240,6 +243,21 @@ double CrossingInterpolationOracle(const SimulatedClip& clip, bool own_threshold
   return Psnr(estimate, clip.frames.frame(kClipTruthFrame));
 }
 
+// --whole_objective: the objective at `result` of the whole problem (one problem, no memory
+// budget), on stderr. A solve in bands minimises overlapping problems whose own costs do not add
+// up to the whole's; this puts both on one scale.
+void PrintWholeObjective(const std::string& name, const char* kind, const Scene& scene,
+                         const Reconstruction& result) {
+  if (!FLAGS_whole_objective) return;
+  ReconstructionOptions whole = Options();
+  whole.max_problem_mb = 0;
+  whole.solver.max_num_iterations = 1;
+  const Reconstruction at_answer = Reconstruct(scene, whole, &result.video);
+  std::fprintf(stderr, "%s %s: whole objective at the answer %.9g (solved as %lld batches)\n",
+               name.c_str(), kind, at_answer.summary.initial_cost,
+               static_cast<long long>(result.summary.problem.batches));
+}
+
 // The interpolation row and, after it, the two crossing-interpolation oracle rows (which
 // solve nothing).
 std::vector<Row> RunClipInterpolation(const std::string& name, const SimulatedClip& clip) {
@@ -249,6 +267,7 @@ std::vector<Row> RunClipInterpolation(const std::string& name, const SimulatedCl
   const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
                                            BaselineOptions(), &initial_method);
   const Reconstruction result = Reconstruct(scene, Options(), &initial);
+  PrintWholeObjective(name, "interpolate", scene, result);
   const int index = result.video.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame));
   const Image& truth = clip.frames.frame(kClipTruthFrame);
   const double blend_psnr = Psnr(InitializeLatentVideo(scene).frame(index), truth);
@@ -320,6 +339,7 @@ std::vector<Row> RunClipDeblur(const std::string& name, const SimulatedClip& cli
   const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
                                            BaselineOptions(), &initial_method);
   const Reconstruction result = Reconstruct(scene, Options(), &initial);
+  PrintWholeObjective(name, "deblur", scene, result);
   const double blurred_psnr =
       MeanPsnrOverClip(clip, [&blurred](const Image&) -> const Image& { return blurred; });
   const Row deblur{name,
