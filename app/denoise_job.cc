@@ -115,8 +115,8 @@ DenoiseRegion SolvedRegion(const Scene& scene, const MethodOptions& method, bool
 }
 
 DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
-                                 const DenoiseRegion& region, const Image* truth, int truth_index,
-                                 Video* latent) {
+                                 const DenoiseRegion& region, const Scene* observed,
+                                 const Image* truth, int truth_index, Video* latent) {
   DenoiseRecord record;
   record.mode = mode;
   record.weights_path = denoiser.weights_path();
@@ -128,7 +128,13 @@ DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
     record.psnr_before = Psnr(before, *truth);
     record.ssim_before = Ssim(before, *truth);
   }
-  *latent = denoiser.Apply(*latent, region, &record.stats);
+  Video denoised = denoiser.Apply(*latent, region, &record.stats);
+  if (observed != nullptr) {
+    record.calibrated = true;
+    record.calibration = CalibrateResidual(*observed, *latent, denoised);
+    ScaleResidual(record.calibration.scale, *latent, &denoised);
+  }
+  *latent = std::move(denoised);
   return record;
 }
 
@@ -189,6 +195,16 @@ Json DenoiseJson(const DenoiseRecord& record) {
                    {"solve_time_s", record.pnp.solve_time_s},
                    {"denoise_time_s", record.pnp.denoise_time_s}};
   }
+  if (record.mode == DenoiseMode::kOnce) {
+    if (record.calibrated) {
+      json["calibration"] = {{"residual_scale", record.calibration.scale},
+                             {"agreement", record.calibration.agreement},
+                             {"energy", record.calibration.energy},
+                             {"observations", record.calibration.observations}};
+    } else {
+      json["calibration"] = nullptr;
+    }
+  }
   if (record.scored) {
     json["psnr_before"] = record.psnr_before;
     json["ssim_before"] = record.ssim_before;
@@ -220,7 +236,8 @@ DenoiseRecord DenoiseReconstructionFolder(const std::string& in_folder, const De
     video.AppendFrame(image, timestamps_ns[t]);
   }
 
-  DenoiseRecord record = DenoiseLatentVideo(denoiser, DenoiseMode::kOnce, {}, nullptr, -1, &video);
+  DenoiseRecord record =
+      DenoiseLatentVideo(denoiser, DenoiseMode::kOnce, {}, nullptr, nullptr, -1, &video);
   const fs::path out(out_folder);
   WriteFrameSequence(out_folder, video);
   Json summary;

@@ -12,6 +12,7 @@
 
 #include "app/method.h"
 #include "app/plug_and_play.h"
+#include "app/residual_calibration.h"
 #include "core/enum_names.h"
 #include "core/video.h"
 #include "denoiser/denoiser.h"
@@ -47,6 +48,8 @@ struct DenoiseRequest {
   DenoiserOptions denoiser;
   /// Mode pnp: the ADMM iterations and ρ schedule.
   PlugAndPlayOptions pnp;
+  /// Mode once: scale the correction by what the scene's frames support (CalibrateResidual).
+  bool calibrate = true;
 };
 
 /// What denoising did, for summary.json.
@@ -61,6 +64,9 @@ struct DenoiseRecord {
   double psnr_before = 0.0, ssim_before = 0.0;
   /// Mode pnp: the ADMM iterations (stats then sums every application of the denoiser).
   PlugAndPlayRecord pnp;
+  /// Mode once with a scene to calibrate against: the residual's scale.
+  bool calibrated = false;
+  ResidualCalibration calibration;
 };
 
 /// The denoiser `request` asks for, loaded (null for mode none). Throws InvalidArgumentError
@@ -72,10 +78,12 @@ std::unique_ptr<Denoiser> LoadDenoiser(const DenoiseRequest& request);
 DenoiseRegion SolvedRegion(const Scene& scene, const MethodOptions& method, bool solved);
 
 /// Applies `denoiser` to `latent` in place at `region`, scoring frame `truth_index` against
-/// `truth` before it does when `truth` is not null.
+/// `truth` before it does when `truth` is not null. When `observed` is not null (the scene
+/// `latent` reconstructs), the correction is scaled by what its frames support
+/// (CalibrateResidual); null applies it as the network gives it.
 DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
-                                 const DenoiseRegion& region, const Image* truth, int truth_index,
-                                 Video* latent);
+                                 const DenoiseRegion& region, const Scene* observed,
+                                 const Image* truth, int truth_index, Video* latent);
 
 /// Throws InvalidArgumentError (one line) when `mode` cannot follow `method`: plug & play
 /// needs the Ceres problem (ceres_lm), whose quadratic prior couples it to the denoiser.

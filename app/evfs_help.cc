@@ -108,6 +108,7 @@ ProgramHelp MakeEvfsHelp() {
       {"in", "denoiser", "denoise"},
       {"denoise", "denoiser", "reconstruct video"},
       {"denoiser", "denoiser", "reconstruct denoise video"},
+      {"denoise_calibration", "denoiser", "reconstruct video"},
       // evfs video's own.
       {"jobs", "solver", "video"},
       {"resume", "output", "video"},

@@ -251,7 +251,8 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
       result.denoise = PlugAndPlayLatentVideo(*denoiser, scene, request.method, request.denoise.pnp,
                                               region, truth, truth_latent, &result.run);
     } else {
-      result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region, truth,
+      result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region,
+                                          request.denoise.calibrate ? &scene : nullptr, truth,
                                           truth_latent, &result.run.video);
     }
   }

@@ -206,7 +206,8 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     const auto denoise_start = Clock::now();
     const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
     DenoiseLatentVideo(*context.denoiser, request.denoise.mode,
-                       SolvedRegion(scene, context.method, run.solved), nullptr, -1, &run.video);
+                       SolvedRegion(scene, context.method, run.solved),
+                       request.denoise.calibrate ? &scene : nullptr, nullptr, -1, &run.video);
     denoise_s = SecondsSince(denoise_start);
   }
   // A sharp observed frame is the output at its own time, unchanged.

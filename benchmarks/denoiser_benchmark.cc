@@ -56,6 +56,10 @@ DEFINE_int32(clip_crop_px, 0,
              "Keep the central N x N pixels of the adobe240 clips (0: whole 500x500 frames).");
 DEFINE_string(cases, "",
               "Only the quality cases whose name contains one of these (comma list); empty: all.");
+DEFINE_bool(denoise_calibration, evfs::DenoiseRequest().calibrate,
+            "DMR + RD once: scale the correction by what the case's frames support, as evfs "
+            "does by default (the scale is printed after the case's name); false: as the "
+            "network gives it.");
 DEFINE_int32(pnp_iterations, evfs::PlugAndPlayOptions().iterations,
              "Plug & play: ADMM iterations.");
 DEFINE_double(pnp_rho, evfs::PlugAndPlayOptions().initial_rho,
@@ -164,7 +168,8 @@ struct QualityCase {
   bool has_truth = true;
   Video dmr, rd, pnp;
   double rd_ms_per_frame = 0.0;
-  double pnp_s = 0.0;  // the ADMM iterations: x-updates and denoising
+  double rd_scale = -1.0;  // the calibrated residual scale; < 0: not calibrated
+  double pnp_s = 0.0;      // the ADMM iterations: x-updates and denoising
   // The latent frames the score reads: the truth-tuned generic denoisers filter only these
   // (the score does not see the others). Empty: every frame.
   std::vector<int> scored_frames;
@@ -250,7 +255,9 @@ QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last
   c.dmr = RunReconstruction(request).run.video;
   request.denoise.denoiser.weights_path = WeightsPath();
   request.denoise.mode = DenoiseMode::kOnce;
+  request.denoise.calibrate = FLAGS_denoise_calibration;
   const ReconstructResult with_rd = RunReconstruction(request);
+  if (with_rd.denoise.calibrated) c.rd_scale = with_rd.denoise.calibration.scale;
   c.rd = with_rd.run.video;
   c.rd_ms_per_frame = 1e3 * with_rd.denoise.stats.time_s / std::max(1, c.rd.num_frames());
   request.denoise.mode = DenoiseMode::kPnp;
@@ -297,9 +304,12 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
   c.name = clip_name + (deblur ? " deblur" : " interpolate");
   c.dmr = run.video;
   const DenoiseRegion region = SolvedRegion(scene, method, run.solved);
-  DenoiseStats stats;
-  c.rd = denoiser.Apply(run.video, region, &stats);
-  c.rd_ms_per_frame = 1e3 * stats.time_s / std::max(1, c.rd.num_frames());
+  c.rd = run.video;
+  const DenoiseRecord once =
+      DenoiseLatentVideo(denoiser, DenoiseMode::kOnce, region,
+                         FLAGS_denoise_calibration ? &scene : nullptr, nullptr, -1, &c.rd);
+  if (once.calibrated) c.rd_scale = once.calibration.scale;
+  c.rd_ms_per_frame = 1e3 * once.stats.time_s / std::max(1, c.rd.num_frames());
   MethodResult pnp_run = run;
   const DenoiseRecord pnp = PlugAndPlayLatentVideo(denoiser, scene, method, PnpFromFlags(), region,
                                                    nullptr, -1, &pnp_run);
@@ -448,6 +458,9 @@ void RunQuality() {
     if (!Wanted(names[i])) continue;
     const QualityCase c = makers[i]();
     const Score dmr = c.score(c.dmr), rd = c.score(c.rd), pnp_score = c.score(c.pnp);
+    char scale[32] = "";
+    if (c.rd_scale >= 0.0) std::snprintf(scale, sizeof(scale), " (s %.2f)", c.rd_scale);
+    const std::string name = c.name + scale;
     double h = 0.0, lambda = 0.0, nlm_ms = 0.0, tv_ms = 0.0;
     Score nlm, tv;
     if (c.has_truth) {
@@ -469,7 +482,7 @@ void RunQuality() {
       std::printf(
           "| %s | %s | %.2f / %.4f | %.2f / %.4f | %+.2f | %.2f / %.4f | %+.2f | %.2f / %.4f (%g) "
           "| %.2f / %.4f (%g) | %.1f, %.1f, %.1f | %.1f |\n",
-          c.name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
+          name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
           rd.first - dmr.first, pnp_score.first, pnp_score.second, pnp_score.first - dmr.first,
           nlm.first, nlm.second, h, tv.first, tv.second, lambda, c.rd_ms_per_frame, nlm_ms, tv_ms,
           c.pnp_s);
@@ -478,7 +491,7 @@ void RunQuality() {
       std::printf(
           "| %s | %s | %.2f / %.2f | %.2f / %.2f | %+.2f | %.2f / %.2f | %+.2f | n/a | n/a | "
           "%.1f, -, - | %.1f |\n",
-          c.name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
+          name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
           rd.first - dmr.first, pnp_score.first, pnp_score.second, pnp_score.first - dmr.first,
           c.rd_ms_per_frame, c.pnp_s);
     }

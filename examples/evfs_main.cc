@@ -212,6 +212,10 @@ DEFINE_string(denoise, "auto",
 DEFINE_string(denoiser, "",
               "The denoiser's ONNX weights (reconstruct, denoise); empty: the shipped "
               "models/evfs_denoiser.onnx.");
+DEFINE_bool(denoise_calibration, evfs::DenoiseRequest().calibrate,
+            "--denoise=once: scale the denoiser's correction by how well it explains the "
+            "recording's own frames (0 where it contradicts them, 1 where it agrees; README "
+            "\"Residual denoiser\"); false applies the network's correction as it is.");
 DEFINE_string(in, "", "denoise: the reconstruction folder (written by evfs reconstruct).");
 DEFINE_double(progress_interval_s, 5.0,
               "While a command runs, a line on stderr (stage, "
@@ -414,6 +418,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   solver.num_threads = FLAGS_threads;
 
   request.denoise.denoiser.weights_path = FLAGS_denoiser;
+  request.denoise.calibrate = FLAGS_denoise_calibration;
   if (FLAGS_denoise == "auto") {
     request.denoise.mode = AutoDenoiseMode(FLAGS_denoiser);
   } else {

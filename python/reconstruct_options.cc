@@ -260,6 +260,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
        [](py::handle v, R* s) {
          s->request.denoise.denoiser.weights_path = ToString("denoiser", v);
        }},
+      {"denoise_calibration", [](const R& s) { return py::cast(s.request.denoise.calibrate); },
+       [](py::handle v, R* s) { s->request.denoise.calibrate = ToBool("denoise_calibration", v); }},
   };
   return table;
 }

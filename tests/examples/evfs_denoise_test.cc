@@ -54,8 +54,10 @@ TEST(EvfsDenoise, ReconstructOnceChangesOnlySolvedPixelsAndRecordsTheWeights) {
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string weights = NetworkPath("two_conv.onnx");
   const std::string plain = Reconstruct(data, scratch + "/plain", "--denoise=none");
+  // The network's correction as it is (the calibration is tested below).
   const std::string denoised =
-      Reconstruct(data, scratch + "/denoised", "--denoise=once --denoiser=" + weights);
+      Reconstruct(data, scratch + "/denoised",
+                  "--denoise=once --denoise_calibration=false --denoiser=" + weights);
 
   const nlohmann::json none = ReadSummary(plain);
   EXPECT_EQ(none["denoiser"]["mode"], "none");
@@ -83,6 +85,35 @@ TEST(EvfsDenoise, ReconstructOnceChangesOnlySolvedPixelsAndRecordsTheWeights) {
   }
   EXPECT_GT(changed_total, 0);
   EXPECT_EQ(record["pixels_changed"].get<int64_t>(), active * frames);
+}
+
+TEST(EvfsDenoise, OnceScalesTheCorrectionByTheCalibrationItRecords) {
+  const std::string scratch = ScratchDir("denoise_calibrated");
+  const std::string data = WriteSyntheticFolder(scratch);
+  const std::string weights = NetworkPath("two_conv.onnx");
+  const std::string plain = Reconstruct(data, scratch + "/plain", "--denoise=none");
+  const std::string full = Reconstruct(
+      data, scratch + "/full", "--denoise=once --denoise_calibration=false --denoiser=" + weights);
+  const std::string calibrated =
+      Reconstruct(data, scratch + "/calibrated", "--denoise=once --denoiser=" + weights);
+
+  EXPECT_TRUE(ReadSummary(full)["denoiser"]["calibration"].is_null());
+  const nlohmann::json calibration = ReadSummary(calibrated)["denoiser"]["calibration"];
+  ASSERT_TRUE(calibration.is_object()) << calibration;
+  const double scale = calibration["residual_scale"].get<double>();
+  EXPECT_GE(scale, 0.0);
+  EXPECT_LE(scale, 1.0);
+  EXPECT_EQ(calibration["observations"].get<int>(), 2);  // the two sharp frames
+  EXPECT_GT(calibration["energy"].get<double>(), 0.0);
+  // Every frame is the reconstruction minus `scale` times the full correction, to the 16-bit
+  // PNG's step.
+  const int frames = CountFrames(plain);
+  ASSERT_EQ(CountFrames(calibrated), frames);
+  for (int t = 0; t < frames; ++t) {
+    const Image before = Frame(plain, t);
+    const Image expected = before - scale * (before - Frame(full, t));
+    EXPECT_LE((Frame(calibrated, t) - expected).abs().maxCoeff(), 1.5 / 65535.0) << "frame " << t;
+  }
 }
 
 TEST(EvfsDenoise, DenoiseCommandWritesAFolderLikeReconstruct) {
