@@ -1,0 +1,53 @@
+#include "app/allocator_tuning.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace evfs {
+namespace {
+
+// The VmFlags of the mapping of /proc/self/smaps that holds `address`; "" when none does.
+std::string VmFlagsAt(const void* address) {
+  const auto at = reinterpret_cast<uintptr_t>(address);
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line)) {
+    uintptr_t begin = 0, end = 0;
+    char dash = 0;
+    std::istringstream range(line);
+    if (range >> std::hex >> begin >> dash >> end && dash == '-') {
+      inside = begin <= at && at < end;
+    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
+      return line;
+    }
+  }
+  return "";
+}
+
+TEST(AllocatorTuning, TheHeapIsAdvisedHugePages) {
+  std::ifstream mode("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  std::getline(mode, modes);
+  if (modes.empty() || modes.find("[never]") != std::string::npos) {
+    GTEST_SKIP() << "this kernel has no transparent huge pages (" << modes << ")";
+  }
+  KeepFreedMemoryForReuse();
+  // A block of the size Ceres allocates per iteration comes from the advised heap: all of it
+  // but the part before the first 2 MB boundary of the grown heap (advice covers whole huge
+  // pages), so 4 MB into it is advised.
+  void* volatile block = std::malloc(8 << 20);
+  ASSERT_NE(block, nullptr);
+  const std::string flags = VmFlagsAt(static_cast<char*>(block) + (4 << 20));
+  std::free(block);
+  ASSERT_FALSE(flags.empty()) << "no mapping holds the block";
+  EXPECT_NE(flags.find(" hg"), std::string::npos) << flags;  // VM_HUGEPAGE
+}
+
+}  // namespace
+}  // namespace evfs
