@@ -20,7 +20,8 @@ namespace evfs {
 /// start-up): the Ceres problem's blocks and vectors then take 2 MB pages instead of 4 KB ones,
 /// 512 times fewer page faults and TLB entries. Whole `evfs reconstruct` on slider_depth took
 /// 0.79 times the time without it (BENCHMARKS.md, "Huge pages for the heap"). The growth is
-/// address space only; memory is used when touched. Where the kernel has no transparent huge
+/// address space only; memory is used when touched. Later growth is glibc's usual, and under an
+/// address-space limit below 256 MB nothing grows ahead and nothing is advised. Where the kernel has no transparent huge
 /// pages (or they are off) the advice changes nothing.
 void KeepFreedMemoryForReuse();
 

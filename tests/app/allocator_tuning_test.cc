@@ -1,6 +1,9 @@
 #include "app/allocator_tuning.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <cstdlib>
@@ -28,6 +31,37 @@ std::string VmFlagsAt(const void* address) {
     }
   }
   return "";
+}
+
+// First in the file: the process's heap has not grown ahead yet (each test also runs in a
+// process of its own under ctest). A child under an address-space limit below the 256 MB the
+// heap grows ahead still gets the memory that fits.
+TEST(AllocatorTuning, AnAddressSpaceLimitBelowTheHeadroomStillAllocates) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no limit fits";
+#endif
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::ifstream statm("/proc/self/statm");
+    size_t pages = 0;
+    statm >> pages;
+    const rlim_t limit = pages * static_cast<size_t>(sysconf(_SC_PAGESIZE)) + (size_t{128} << 20);
+    const rlimit as{limit, limit};
+    if (setrlimit(RLIMIT_AS, &as) != 0) _exit(3);
+    KeepFreedMemoryForReuse();
+    // 64 MB in 8 blocks, well within the limit.
+    for (int i = 0; i < 8; ++i) {
+      char* volatile block = static_cast<char*>(std::malloc(size_t{8} << 20));
+      if (block == nullptr) _exit(1);
+      block[0] = 1;
+    }
+    _exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: malloc failed under the limit; 3: setrlimit failed";
 }
 
 TEST(AllocatorTuning, TheHeapIsAdvisedHugePages) {
