@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "app/allocator_tuning.h"
+#include "app/method.h"
 #include "core/metrics.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
@@ -75,8 +76,8 @@ TimedFrame Sharp(const Video& video, int t) {
 int Run() {
   std::printf(
       "| active fraction | events | active pixels | unknowns | latent frames | build s "
-      "| solve s | µs per unknown | PSNR gain over blend |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+      "| solve s | µs per unknown | PSNR blend / integration / evfs | gain over blend |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const double fraction : ParseFractions(FLAGS_fractions)) {
     const Video video = BandVideo(fraction);
     const EventStream events = SimulateEvents(video, SimulatorOptions());
@@ -98,18 +99,24 @@ int Run() {
     const Video blend = InitializeLatentVideo(scene);
     const int index = result.video.NearestFrame(video.timestamp_ns(middle));
     // Without events the answer is the blend itself: no gain to report.
-    char gain[32] = "-";
+    char gain[32] = "-", scores[64] = "-";
     if (result.summary.solved) {
-      std::snprintf(gain, sizeof(gain), "%+.2f dB",
-                    Psnr(result.video.frame(index), truth) - Psnr(blend.frame(index), truth));
+      MethodOptions integrate;
+      integrate.method = Method::kIntegrate;
+      const Video integrated = RunMethod(scene, integrate).video;
+      const double evfs = Psnr(result.video.frame(index), truth);
+      const double blended = Psnr(blend.frame(index), truth);
+      std::snprintf(scores, sizeof(scores), "%.2f / %.2f / %.2f dB", blended,
+                    Psnr(integrated.frame(index), truth), evfs);
+      std::snprintf(gain, sizeof(gain), "%+.2f dB", evfs - blended);
     }
     const double per_unknown =
         unknowns > 0 ? 1e6 * (Median(build_s) + Median(solve_s)) / unknowns : 0.0;
-    std::printf("| %.0f %% | %lld | %lld | %lld | %d | %.3f | %.3f | %.1f | %s |\n",
+    std::printf("| %.0f %% | %lld | %lld | %lld | %d | %.3f | %.3f | %.1f | %s | %s |\n",
                 100.0 * fraction, static_cast<long long>(events.size()),
                 static_cast<long long>(result.summary.problem.active_pixels),
                 static_cast<long long>(unknowns), scene.num_latent_frames(), Median(build_s),
-                Median(solve_s), per_unknown, gain);
+                Median(solve_s), per_unknown, scores, gain);
     std::fflush(stdout);
   }
   return 0;
