@@ -202,12 +202,13 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   }
   MethodResult run = RunMethod(scene, context.method, IterationCallback(), false, nullptr);
   double denoise_s = 0.0;
+  DenoiseRecord denoised;
   if (context.denoiser != nullptr) {
     const auto denoise_start = Clock::now();
     const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
-    DenoiseLatentVideo(*context.denoiser, request.denoise.mode,
-                       SolvedRegion(scene, context.method, run.solved),
-                       request.denoise.calibrate ? &scene : nullptr, nullptr, -1, &run.video);
+    denoised = DenoiseLatentVideo(
+        *context.denoiser, request.denoise.mode, SolvedRegion(scene, context.method, run.solved),
+        request.denoise.calibrate ? &scene : nullptr, nullptr, -1, &run.video);
     denoise_s = SecondsSince(denoise_start);
   }
   // A sharp observed frame is the output at its own time, unchanged.
@@ -256,6 +257,8 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["iterations"] = run.iterations;
   record["initial_cost"] = Number(run.initial_cost);
   record["final_cost"] = Number(run.final_cost);
+  // With --denoise=once: the scale of the denoiser's correction this window's frames supported.
+  if (denoised.calibrated) record["residual_scale"] = Number(denoised.calibration.scale);
   if (!window.truth_frames.empty()) {
     const Video blend = InitializeLatentVideo(scene);
     Json scores = Json::array();

@@ -116,6 +116,32 @@ TEST(EvfsDenoise, OnceScalesTheCorrectionByTheCalibrationItRecords) {
   }
 }
 
+TEST(EvfsDenoise, VideoWindowsRecordTheScaleTheirFramesSupported) {
+  const std::string scratch = ScratchDir("denoise_video");
+  const std::string data = WriteSyntheticFolder(scratch);
+  const std::string common = "video --data=" + data + " --fps=1000 --denoise=once --denoiser=" +
+                             NetworkPath("two_conv.onnx");
+  const CommandResult calibrated = RunEvfs(common + " --out=" + scratch + "/calibrated");
+  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.output;
+  const CommandResult full =
+      RunEvfs(common + " --denoise_calibration=false --out=" + scratch + "/full");
+  ASSERT_EQ(full.exit_code, 0) << full.output;
+  int solved = 0;
+  const nlohmann::json with = ReadSummary(scratch + "/calibrated");
+  for (const nlohmann::json& window : with["windows"]) {
+    if (!window["solved"].get<bool>()) continue;
+    ++solved;
+    ASSERT_TRUE(window.contains("residual_scale")) << window;
+    EXPECT_GE(window["residual_scale"].get<double>(), 0.0);
+    EXPECT_LE(window["residual_scale"].get<double>(), 1.0);
+  }
+  EXPECT_GT(solved, 0);
+  const nlohmann::json without = ReadSummary(scratch + "/full");
+  for (const nlohmann::json& window : without["windows"]) {
+    EXPECT_FALSE(window.contains("residual_scale")) << window;
+  }
+}
+
 TEST(EvfsDenoise, DenoiseCommandWritesAFolderLikeReconstruct) {
   const std::string scratch = ScratchDir("denoise_command");
   const std::string data = WriteSyntheticFolder(scratch);
