@@ -21,8 +21,8 @@ namespace evfs {
 /// 512 times fewer page faults and TLB entries. Whole `evfs reconstruct` on slider_depth took
 /// 0.79 times the time without it (BENCHMARKS.md, "Huge pages for the heap"). The growth is
 /// address space only; memory is used when touched. Later growth is glibc's usual, and under an
-/// address-space limit below 256 MB nothing grows ahead and nothing is advised. Where the kernel has no transparent huge
-/// pages (or they are off) the advice changes nothing.
+/// address-space limit below 256 MB nothing grows ahead and nothing is advised. Where the kernel
+/// has no transparent huge pages (or they are off) the advice changes nothing.
 void KeepFreedMemoryForReuse();
 
 }  // namespace evfs
