@@ -202,11 +202,11 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   }
   MethodResult run = RunMethod(scene, context.method, IterationCallback(), false, nullptr);
   double denoise_s = 0.0;
-  DenoiseRecord denoised;
+  DenoiseRecord denoise_record;
   if (context.denoiser != nullptr) {
     const auto denoise_start = Clock::now();
     const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
-    denoised = DenoiseLatentVideo(
+    denoise_record = DenoiseLatentVideo(
         *context.denoiser, request.denoise.mode, SolvedRegion(scene, context.method, run.solved),
         request.denoise.calibrate ? &scene : nullptr, nullptr, -1, &run.video);
     denoise_s = SecondsSince(denoise_start);
@@ -258,7 +258,9 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["initial_cost"] = Number(run.initial_cost);
   record["final_cost"] = Number(run.final_cost);
   // With --denoise=once: the scale of the denoiser's correction this window's frames supported.
-  if (denoised.calibrated) record["residual_scale"] = Number(denoised.calibration.scale);
+  if (denoise_record.calibrated) {
+    record["residual_scale"] = Number(denoise_record.calibration.scale);
+  }
   if (!window.truth_frames.empty()) {
     const Video blend = InitializeLatentVideo(scene);
     Json scores = Json::array();
