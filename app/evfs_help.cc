@@ -85,6 +85,7 @@ ProgramHelp MakeEvfsHelp() {
       {"per_polarity_alpha", "model", "reconstruct video"},
       {"log_offset", "model", "reconstruct video"},
       {"spatial_tv", "model", "reconstruct video"},
+      {"shared_structure_tv", "model", "reconstruct video"},
       {"smoothing_scale", "model", "reconstruct video"},
       {"smoothing_continuation", "model", "reconstruct video"},
       {"bounds", "model", "reconstruct video"},

@@ -331,6 +331,7 @@ Json ModelJson(const ObjectiveOptions& objective, const ReconstructionSummary& s
   json["spatial_tv_weight"] = Number(objective.spatial_tv_weight);
   json["temporal_tv_weight"] = Number(objective.temporal_tv_weight);
   json["spatial_tv"] = SpatialTvName(objective.spatial_tv);
+  json["shared_structure_tv"] = objective.shared_structure_tv;
   json["smoothing_scale"] = Number(objective.smoothing_scale);
   return json;
 }

@@ -149,6 +149,10 @@ DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset,
 DEFINE_string(spatial_tv, "anisotropic",
               "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | "
               "isotropic (sqrt(dx^2+dy^2)).");
+DEFINE_bool(shared_structure_tv, evfs::ObjectiveOptions().shared_structure_tv,
+            "Between two sharp frames, measure spatial TV from the structure both frames show in "
+            "place (minmod of their differences): texture they share is kept, moved edges are "
+            "not.");
 DEFINE_double(smoothing_scale, evfs::ObjectiveOptions().smoothing_scale,
               "epsilon of the smoothed l1: sqrt(eps^2 + r^2) - eps.");
 DEFINE_bool(bounds, true, "Keep intensities in [0, 1].");
@@ -394,6 +398,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   objective.smoothing_scale = FLAGS_smoothing_scale;
   objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
   objective.spatial_tv = ParseName(kSpatialTvNames, FLAGS_spatial_tv, "--spatial_tv");
+  objective.shared_structure_tv = FLAGS_shared_structure_tv;
   options.bound_intensities = FLAGS_bounds;
   options.activity_radius_px = FLAGS_activity_radius_px;
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;

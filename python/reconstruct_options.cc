@@ -181,6 +181,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
                       [](R& s) -> double& { return Objective(s).event_model.log_offset; }),
       EnumOption<R>("spatial_tv", kSpatialTvNames,
                     [](R& s) -> SpatialTv& { return Objective(s).spatial_tv; }),
+      BoolOption<R>("shared_structure_tv",
+                    [](R& s) -> bool& { return Objective(s).shared_structure_tv; }),
       DoubleOption<R>("smoothing_scale",
                       [](R& s) -> double& { return Objective(s).smoothing_scale; }),
       {"smoothing_continuation",

@@ -53,19 +53,24 @@ struct Penalty<L1Penalty::kTrueL1> {
 // Spatial TV terms owned by the pixels [begin, end) of one row of one latent frame: adds their
 // cost to cost[x] and writes the coefficients of their gradient, ∂/∂H(x+1, y) into
 // coef_right[x] and ∂/∂H(x, y+1) into coef_below[x] (∂/∂H(x, y) is minus their sum). right[x]
-// and below[x] are the neighbours of center[x]; where a term does not exist its mask is 0.
-template <L1Penalty kPenalty>
+// and below[x] are the neighbours of center[x]; where a term does not exist its mask is 0. Each
+// difference is measured from its offset (offset_right[x], offset_below[x]; ObjectiveTerms),
+// read only when kOffsets (plain TV passes null).
+template <L1Penalty kPenalty, bool kOffsets>
 void SpatialTerms(SpatialTv form, const double* center, const double* right, const double* below,
-                  const double* mask_right, const double* mask_below, double weight, double eps,
-                  int begin, int end, double* __restrict coef_right, double* __restrict coef_below,
+                  const double* mask_right, const double* mask_below, const double* offset_right,
+                  const double* offset_below, double weight, double eps, int begin, int end,
+                  double* __restrict coef_right, double* __restrict coef_below,
                   double* __restrict cost) {
   using P = Penalty<kPenalty>;
+  const auto offset_x = [&](int x) { return kOffsets ? offset_right[x] : 0.0; };
+  const auto offset_y = [&](int x) { return kOffsets ? offset_below[x] : 0.0; };
   switch (form) {
     case SpatialTv::kAnisotropic:
       for (int x = begin; x < end; ++x) {
         double slope_x, slope_y;
-        const double value_x = P::Scalar(right[x] - center[x], eps, &slope_x);
-        const double value_y = P::Scalar(below[x] - center[x], eps, &slope_y);
+        const double value_x = P::Scalar(right[x] - center[x] - offset_x(x), eps, &slope_x);
+        const double value_y = P::Scalar(below[x] - center[x] - offset_y(x), eps, &slope_y);
         const double weight_x = weight * mask_right[x], weight_y = weight * mask_below[x];
         cost[x] += weight_x * value_x + weight_y * value_y;
         coef_right[x] = weight_x * slope_x;
@@ -76,7 +81,8 @@ void SpatialTerms(SpatialTv form, const double* center, const double* right, con
       for (int x = begin; x < end; ++x) {
         double slope;
         const double value =
-            P::Scalar((right[x] - center[x]) + (below[x] - center[x]), eps, &slope);
+            P::Scalar((right[x] - center[x]) + (below[x] - center[x]) - offset_x(x) - offset_y(x),
+                      eps, &slope);
         const double weight_here = weight * mask_right[x];
         cost[x] += weight_here * value;
         coef_right[x] = coef_below[x] = weight_here * slope;
@@ -84,7 +90,8 @@ void SpatialTerms(SpatialTv form, const double* center, const double* right, con
       break;
     case SpatialTv::kIsotropic:
       for (int x = begin; x < end; ++x) {
-        const double dx = right[x] - center[x], dy = below[x] - center[x];
+        const double dx = right[x] - center[x] - offset_x(x);
+        const double dy = below[x] - center[x] - offset_y(x);
         double scale;
         const double value = P::Norm(dx * dx + dy * dy, eps, &scale);
         const double weight_here = weight * mask_right[x];
@@ -189,6 +196,9 @@ struct FusedObjective::Impl {
   // 1 where a spatial TV term exists: the horizontal one (or the only one, for the paper and
   // isotropic forms) and the vertical one of anisotropic TV.
   std::vector<double> mask_right, mask_below;
+  // What each difference is measured from (ObjectiveTerms::spatial_tv_offset_at); empty for
+  // plain TV.
+  std::vector<double> offset_right, offset_below;
   std::vector<Band> bands;
   BandFunction evaluate_band = nullptr;
   mutable std::vector<Scratch> scratch;
@@ -267,6 +277,10 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
   if (spatial_weight > 0.0) {
     mask_right.assign(pixels, 0.0);
     mask_below.assign(pixels, 0.0);
+    if (terms.has_spatial_tv_offsets()) {
+      offset_right.assign(pixels, 0.0);
+      offset_below.assign(pixels, 0.0);
+    }
     const bool anisotropic = spatial_tv == SpatialTv::kAnisotropic;
     for (int y = 0; y < height; ++y) {
       Row& row = rows[y];
@@ -280,6 +294,11 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
         const SpatialTvTermsAt owned = terms.spatial_tv_terms_at(p);
         mask_right[p] = owned.right;
         mask_below[p] = anisotropic ? owned.below : owned.right;
+        if (!offset_right.empty()) {
+          const SpatialTvOffset offset = terms.spatial_tv_offset_at(p);
+          offset_right[p] = offset.right;
+          offset_below[p] = offset.below;
+        }
         const bool here = mask.active(p);
         const bool below = y + 1 < height && mask.active(p + width);
         if (mask_right[p] > 0.0 || mask_below[p] > 0.0 || below) need(x);
@@ -377,6 +396,10 @@ void FusedObjective::Impl::SpatialRow(int y, const double* latent, double* coef_
   const int64_t row_start = static_cast<int64_t>(y) * width;
   const double* row_mask_right = mask_right.data() + row_start;
   const double* row_mask_below = mask_below.data() + row_start;
+  const bool offsets = !offset_right.empty();
+  const double* row_offset_right = offsets ? offset_right.data() + row_start : nullptr;
+  const double* row_offset_below = offsets ? offset_below.data() + row_start : nullptr;
+  const auto terms = offsets ? SpatialTerms<kPenalty, true> : SpatialTerms<kPenalty, false>;
   // The last column has no right neighbour and the last row none below: they are read as the
   // pixel itself, and the masks drop the terms that would need them.
   const int inner_end = std::min(row.coef_end, width - 1);
@@ -385,13 +408,13 @@ void FusedObjective::Impl::SpatialRow(int y, const double* latent, double* coef_
     const double* below = y + 1 < height ? center + width : center;
     double* frame_coef_right = scratch->coef_right.data() + t * (width + 1) + 1;
     double* frame_coef_below = coef_below + t * width;
-    SpatialTerms<kPenalty>(spatial_tv, center, center + 1, below, row_mask_right, row_mask_below,
-                           spatial_weight, eps, row.coef_begin, inner_end, frame_coef_right,
-                           frame_coef_below, cost);
+    terms(spatial_tv, center, center + 1, below, row_mask_right, row_mask_below, row_offset_right,
+          row_offset_below, spatial_weight, eps, row.coef_begin, inner_end, frame_coef_right,
+          frame_coef_below, cost);
     if (row.coef_end == width) {
-      SpatialTerms<kPenalty>(spatial_tv, center, center, below, row_mask_right, row_mask_below,
-                             spatial_weight, eps, width - 1, width, frame_coef_right,
-                             frame_coef_below, cost);
+      terms(spatial_tv, center, center, below, row_mask_right, row_mask_below, row_offset_right,
+            row_offset_below, spatial_weight, eps, width - 1, width, frame_coef_right,
+            frame_coef_below, cost);
     }
   }
 }

@@ -1,5 +1,7 @@
 #include "solver/objective_terms.h"
 
+#include <algorithm>
+
 #include "core/error.h"
 
 namespace evfs {
@@ -50,11 +52,45 @@ ObjectiveTerms::ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objec
     }
     counts_[static_cast<int>(TermFamily::kSpatialTv)] = per_frame * num_latent;
   }
+  if (has(TermFamily::kSpatialTv) && objective.shared_structure_tv) {
+    ComputeSharedStructureOffsets(scene);
+  }
   if (has(TermFamily::kTemporalTv)) {
     counts_[static_cast<int>(TermFamily::kTemporalTv)] = (num_latent - 1) * active;
   }
   if (has(TermFamily::kPrior)) {
     counts_[static_cast<int>(TermFamily::kPrior)] = static_cast<int64_t>(num_latent) * active;
+  }
+}
+
+void ObjectiveTerms::ComputeSharedStructureOffsets(const Scene& scene) {
+  const FrameObservation* first = nullptr;
+  const FrameObservation* last = nullptr;
+  for (const FrameObservation& frame : scene.frames) {
+    if (frame.latent_first != frame.latent_last) continue;  // blurred: no structure in place
+    if (first == nullptr || frame.latent_first < first->latent_first) first = &frame;
+    if (last == nullptr || frame.latent_first > last->latent_first) last = &frame;
+  }
+  if (first == nullptr || first->latent_first == last->latent_first) return;
+  // The smaller of two differences of the same sign, else 0: what both frames show in place.
+  const auto minmod = [](double a, double b) {
+    if (a > 0.0 && b > 0.0) return std::min(a, b);
+    if (a < 0.0 && b < 0.0) return std::max(a, b);
+    return 0.0;
+  };
+  const double* f = first->image.data();
+  const double* l = last->image.data();
+  const int64_t pixels = static_cast<int64_t>(height_) * width_;
+  tv_offset_right_.assign(pixels, 0.0);
+  tv_offset_below_.assign(pixels, 0.0);
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const int64_t p = static_cast<int64_t>(y) * width_ + x;
+      if (x + 1 < width_) tv_offset_right_[p] = minmod(f[p + 1] - f[p], l[p + 1] - l[p]);
+      if (y + 1 < height_) {
+        tv_offset_below_[p] = minmod(f[p + width_] - f[p], l[p + width_] - l[p]);
+      }
+    }
   }
 }
 

@@ -26,6 +26,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "scene/activity_mask.h"
 #include "scene/scene.h"
@@ -45,6 +46,13 @@ struct SpatialTvTermsAt {
   bool below = false;
 };
 
+/// What a pixel's spatial TV differences are measured from (ObjectiveOptions::
+/// shared_structure_tv): r = dx H − right, dy H − below. Both 0 for plain TV.
+struct SpatialTvOffset {
+  double right = 0.0;  // of the difference towards (x + 1, y)
+  double below = 0.0;  // of the difference towards (x, y + 1)
+};
+
 /// The terms of the objective for one scene, activity mask and objective options. Counts are of
 /// terms over voxels (one per latent frame or step, before any merging of quiet steps).
 class ObjectiveTerms {
@@ -62,13 +70,26 @@ class ObjectiveTerms {
 
   /// The spatial TV terms pixel p owns; none when the family has no terms.
   SpatialTvTermsAt spatial_tv_terms_at(int64_t p) const;
+  /// Whether spatial TV is measured from the structure the scene's first and last sharp frames
+  /// share: shared_structure_tv with spatial TV terms and two sharp frames at different times.
+  bool has_spatial_tv_offsets() const { return !tv_offset_right_.empty(); }
+  /// The offsets of pixel p's spatial TV differences: minmod(F_first(q) − F_first(p),
+  /// F_last(q) − F_last(p)) for q its right and lower neighbours (0 without a neighbour), or 0
+  /// when !has_spatial_tv_offsets().
+  SpatialTvOffset spatial_tv_offset_at(int64_t p) const {
+    if (!has_spatial_tv_offsets()) return {};
+    return {tv_offset_right_[p], tv_offset_below_[p]};
+  }
 
  private:
+  void ComputeSharedStructureOffsets(const Scene& scene);
+
   const ActivityMask& mask_;
   int height_ = 0, width_ = 0;
   SpatialTv spatial_tv_ = SpatialTv::kAnisotropic;
   std::array<double, kNumTermFamilies> weights_{};
   std::array<int64_t, kNumTermFamilies> counts_{};
+  std::vector<double> tv_offset_right_, tv_offset_below_;  // per pixel; empty: plain TV
 };
 
 }  // namespace evfs

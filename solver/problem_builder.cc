@@ -20,8 +20,9 @@ namespace evfs {
 namespace {
 
 // Cost functions depend only on (family, observed value, shape), and observations take few
-// distinct values (events are {-1, 0, 1} or small counts, frames 8- or 16-bit levels), so one
-// cost function per key serves every residual block that shares it. The shape is the number of
+// distinct values (events are {-1, 0, 1} or small counts, frames 8- or 16-bit levels, spatial TV
+// offsets differences of those), so one cost function per key serves every residual block that
+// shares it. The shape is the number of
 // steps of an event frame, or the run lengths of a frame observation's segments.
 class CostFunctionCache {
  public:
@@ -32,7 +33,13 @@ class CostFunctionCache {
 
   ceres::CostFunction* Get(Family family, double value, const std::vector<int>& shape,
                            const std::function<ceres::CostFunction*()>& create) {
-    Key key(family, value, shape);
+    return Get(family, value, 0.0, shape, create);
+  }
+  // A key of two values: the offsets of a two-difference spatial TV term.
+  ceres::CostFunction* Get(Family family, double value, double second_value,
+                           const std::vector<int>& shape,
+                           const std::function<ceres::CostFunction*()>& create) {
+    Key key(family, value, second_value, shape);
     const auto it = cache_.find(key);
     if (it != cache_.end()) return it->second;
     owned_->emplace_back(create());
@@ -41,7 +48,7 @@ class CostFunctionCache {
   }
 
  private:
-  using Key = std::tuple<Family, double, std::vector<int>>;
+  using Key = std::tuple<Family, double, double, std::vector<int>>;
   std::vector<std::unique_ptr<ceres::CostFunction>>* owned_;
   std::map<Key, ceres::CostFunction*> cache_;
 };
@@ -369,15 +376,24 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
   if (terms.has(TermFamily::kSpatialTv)) {
     const double weight = terms.weight(TermFamily::kSpatialTv);
     // Anisotropic TV is two difference residuals; the other forms one three-point residual.
+    // Each is measured from the pixel's offsets (0 for plain TV).
     const bool anisotropic = objective.spatial_tv == SpatialTv::kAnisotropic;
-    ceres::CostFunction* spatial_cost = cache.Get(Family::kSpatialTv, 0.0, {}, [&] {
-      if (anisotropic) return DifferenceResidual::Create();
-      return objective.spatial_tv == SpatialTv::kIsotropic ? IsotropicTvResidual::Create()
-                                                           : PaperTvResidual::Create();
-    });
+    // A difference's cost from its offset o_x (anisotropic), or a three-point term's from its
+    // (o_x, o_y).
+    const auto spatial_cost = [&](double offset_x, double offset_y) {
+      return cache.Get(Family::kSpatialTv, offset_x, offset_y, {}, [&]() -> ceres::CostFunction* {
+        if (anisotropic) return DifferenceResidual::Create(offset_x);
+        return objective.spatial_tv == SpatialTv::kIsotropic
+                   ? IsotropicTvResidual::Create(offset_x, offset_y)
+                   : PaperTvResidual::Create(offset_x, offset_y);
+      });
+    };
+    ceres::CostFunction* const plain_cost = spatial_cost(0.0, 0.0);
+    const bool offsets = terms.has_spatial_tv_offsets();
     // One residual per run of latent frames over which the pixels it touches keep their
     // segments: the run's m identical terms, weighted m times.
-    const auto add_runs = [&](std::initializer_list<int64_t> touched) {
+    const auto add_runs = [&](ceres::CostFunction* spatial_cost,
+                              std::initializer_list<int64_t> touched) {
       int run_first = 0;
       for (int t = 1; t <= num_latent; ++t) {
         bool same = t < num_latent;
@@ -398,12 +414,18 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
     // A band builds only the terms that touch its own rows.
     for (const int64_t p : pixels) {
       const SpatialTvTermsAt owned = terms.spatial_tv_terms_at(p);
+      const SpatialTvOffset offset = terms.spatial_tv_offset_at(p);
       const bool here = inside(p), below = inside(p + width);
       if (anisotropic) {
-        if (owned.right && here) add_runs({p, p + 1});
-        if (owned.below && (here || below)) add_runs({p, p + width});
+        if (owned.right && here) {
+          add_runs(offsets ? spatial_cost(offset.right, 0.0) : plain_cost, {p, p + 1});
+        }
+        if (owned.below && (here || below)) {
+          add_runs(offsets ? spatial_cost(offset.below, 0.0) : plain_cost, {p, p + width});
+        }
       } else if (owned.right && (here || below)) {
-        add_runs({p, p + 1, p + width});
+        add_runs(offsets ? spatial_cost(offset.right, offset.below) : plain_cost,
+                 {p, p + 1, p + width});
       }
     }
   }

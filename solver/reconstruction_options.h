@@ -43,6 +43,15 @@ struct ObjectiveOptions {
   EventModelParams event_model = DefaultEventModel();
   /// Form of the spatial TV.
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
+  /// Between two sharp frames, measure each spatial TV difference from the structure both
+  /// frames show in place: dx H − minmod(dx F_first, dx F_last), the same for dy, with minmod
+  /// the smaller of the two where they have the same sign and 0 where not (ObjectiveTerms). A
+  /// texture both frames show costs nothing to keep; an edge only one frame shows there is still
+  /// penalised. Scenes without two sharp frames keep plain TV. Off by default: it lifts the quiet
+  /// windows of issue 16 (GOPR9642 24, 28 → 26 by 1 dB) and the clips' interpolations on the
+  /// mean, but costs GOPR9642 0, 4 → 2 0.19 dB (BENCHMARKS.md, "Spatial TV of what the frames do
+  /// not share").
+  bool shared_structure_tv = false;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
   /// ρ: weight of a quadratic prior ρ/2 · mean over the solved voxels of (H_t(p) − T_t(p))²

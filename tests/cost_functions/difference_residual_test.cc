@@ -22,6 +22,15 @@ TEST(DifferenceResidual, Nominal) {
   EXPECT_EQ(evaluation.jacobians[1][0], 1.0);
 }
 
+TEST(DifferenceResidual, MeasuredFromItsOffset) {
+  const std::unique_ptr<ceres::CostFunction> cost(DifferenceResidual::Create(0.125));
+  const test::Evaluation evaluation = test::Evaluate(*cost, {0.25, 0.75});
+  ASSERT_TRUE(evaluation.return_value);
+  EXPECT_NEAR(evaluation.residuals[0], 0.5 - 0.125, kNominalTolerance);
+  EXPECT_EQ(evaluation.jacobians[0][0], -1.0);
+  EXPECT_EQ(evaluation.jacobians[1][0], 1.0);
+}
+
 TEST(DifferenceResidual, GradientCheck) {
   std::mt19937 rng(19);
   const std::unique_ptr<ceres::CostFunction> cost(DifferenceResidual::Create());

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "scene/activity_mask.h"
+#include "solver/objective_terms.h"
 #include "solver/problem_builder.h"
 
 namespace evfs {
@@ -229,6 +230,23 @@ TEST(FusedObjective, MatchesTheProblemWithAnOffSlope) {
     options.objective.event_model.off_alpha_ratio = 1.7;
     SCOPED_TRACE(EventModelName(model));
     ExpectFusedMatchesCeres(scene, options, MakeRandomLatent(42), /*num_threads=*/2);
+  }
+}
+
+TEST(FusedObjective, MatchesTheProblemWithSharedStructureTv) {
+  // Spatial TV measured from the minmod of the two sharp frames' differences (random frames:
+  // offsets of both signs and zeros), every form, one unknown per voxel and merged segments.
+  for (const SpatialTv form : {SpatialTv::kPaper, SpatialTv::kAnisotropic, SpatialTv::kIsotropic}) {
+    for (const bool merged : {false, true}) {
+      const Scene scene = MakeRandomScene(Binning::kCollision, Activity::kPartial, 51);
+      ReconstructionOptions options = MakeOptions(form, EventModel::kLog, Activity::kPartial);
+      options.objective.shared_structure_tv = true;
+      options.merge_quiet_steps = merged;
+      const ActivityMask mask(scene.events, options.activity_radius_px);
+      ASSERT_TRUE(ObjectiveTerms(scene, options.objective, mask).has_spatial_tv_offsets());
+      SCOPED_TRACE(std::string(SpatialTvName(form)) + (merged ? " merged" : " per voxel"));
+      ExpectFusedMatchesCeres(scene, options, MakeRandomLatent(52), /*num_threads=*/3);
+    }
   }
 }
 

@@ -198,5 +198,57 @@ TEST(ObjectiveTerms, PriorIsAMeanOverVoxelsAndNeedsATargetOfTheLatentSize) {
   EXPECT_THROW(ObjectiveTerms(scene, objective, mask), InvalidArgumentError);
 }
 
+TEST(ObjectiveTerms, SharedStructureOffsetsAreTheMinmodOfTheTwoFrames) {
+  Scene scene = MakeScene({{1, 2, 3}});
+  // Row 0 of the first frame rises by 0.1 per column, of the last by 0.3 (shared: 0.1); row 1
+  // rises in the first and falls in the last (shared: none). Below: first frame's row 1 minus
+  // row 0 is 0.2 at column 0, the last frame's 0.5 (shared: 0.2).
+  Image& first = scene.frames[0].image;
+  Image& last = scene.frames[1].image;
+  first.setConstant(0.5);
+  last.setConstant(0.5);
+  for (int x = 0; x < kWidth; ++x) {
+    first(0, x) = 0.1 + 0.1 * x;
+    last(0, x) = 0.1 + 0.3 * x;
+    first(1, x) = 0.3 + 0.05 * x;
+    last(1, x) = 0.6 - 0.05 * x;
+  }
+  const ActivityMask mask(scene.events, /*radius_px=*/-1);
+  ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+  EXPECT_FALSE(ObjectiveTerms(scene, objective, mask).has_spatial_tv_offsets());
+  EXPECT_EQ(ObjectiveTerms(scene, objective, mask).spatial_tv_offset_at(0).right, 0.0);
+
+  objective.shared_structure_tv = true;
+  const ObjectiveTerms terms(scene, objective, mask);
+  ASSERT_TRUE(terms.has_spatial_tv_offsets());
+  EXPECT_NEAR(terms.spatial_tv_offset_at(0).right, 0.1, 1e-12);
+  EXPECT_NEAR(terms.spatial_tv_offset_at(2).right, 0.1, 1e-12);
+  EXPECT_EQ(terms.spatial_tv_offset_at(kWidth + 1).right, 0.0);   // opposite signs
+  EXPECT_NEAR(terms.spatial_tv_offset_at(0).below, 0.2, 1e-12);   // 0.3 − 0.1 and 0.6 − 0.1
+  EXPECT_EQ(terms.spatial_tv_offset_at(kWidth - 1).right, 0.0);   // no right neighbour
+  EXPECT_EQ(terms.spatial_tv_offset_at(kPixels - 1).below, 0.0);  // no lower neighbour
+  // A falling edge in both frames: the smaller fall.
+  first(3, 0) = 0.9;
+  last(3, 0) = 0.7;
+  const ObjectiveTerms falling(scene, objective, mask);
+  EXPECT_NEAR(falling.spatial_tv_offset_at(3 * kWidth).right, 0.5 - 0.7, 1e-12);
+}
+
+TEST(ObjectiveTerms, NoSharedStructureWithoutTwoSharpFrames) {
+  const Scene two_frames = MakeScene({{1, 2, 3}});
+  const ActivityMask mask(two_frames.events, /*radius_px=*/-1);
+  ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+  objective.shared_structure_tv = true;
+  EXPECT_TRUE(ObjectiveTerms(two_frames, objective, mask).has_spatial_tv_offsets());
+  Scene one_frame = MakeScene({{1, 2, 3}});  // a prediction: the first frame only
+  one_frame.frames.pop_back();
+  EXPECT_FALSE(ObjectiveTerms(one_frame, objective, mask).has_spatial_tv_offsets());
+  Scene blurred = MakeScene({{1, 2, 3}});  // the last frame blurred over the window
+  blurred.frames[1].latent_first = 0;
+  EXPECT_FALSE(ObjectiveTerms(blurred, objective, mask).has_spatial_tv_offsets());
+  objective.spatial_tv_weight = 0.0;  // no spatial TV: nothing to measure
+  EXPECT_FALSE(ObjectiveTerms(two_frames, objective, mask).has_spatial_tv_offsets());
+}
+
 }  // namespace
 }  // namespace evfs
