@@ -1,6 +1,7 @@
 #include "solver/objective_terms.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.h"
 
@@ -73,10 +74,13 @@ void ObjectiveTerms::ComputeSharedStructureOffsets(const Scene& scene) {
   }
   if (first == nullptr || first->latent_first == last->latent_first) return;
   // The smaller of two differences of the same sign, else 0: what both frames show in place.
+  // Rounded to kSpatialTvOffsetStep: the Ceres problem holds one cost function per distinct
+  // offset, and 16-bit frames would otherwise give one per pixel.
   const auto minmod = [](double a, double b) {
-    if (a > 0.0 && b > 0.0) return std::min(a, b);
-    if (a < 0.0 && b < 0.0) return std::max(a, b);
-    return 0.0;
+    double shared = 0.0;
+    if (a > 0.0 && b > 0.0) shared = std::min(a, b);
+    if (a < 0.0 && b < 0.0) shared = std::max(a, b);
+    return std::round(shared / kSpatialTvOffsetStep) * kSpatialTvOffsetStep;
   };
   const double* f = first->image.data();
   const double* l = last->image.data();

@@ -53,6 +53,10 @@ struct SpatialTvOffset {
   double below = 0.0;  // of the difference towards (x, y + 1)
 };
 
+/// The resolution of the spatial TV offsets: 1/1024 of the intensity range, a quarter of an
+/// 8-bit level and far below the smoothing scale, so that there are at most 2049 offsets.
+inline constexpr double kSpatialTvOffsetStep = 1.0 / 1024.0;
+
 /// The terms of the objective for one scene, activity mask and objective options. Counts are of
 /// terms over voxels (one per latent frame or step, before any merging of quiet steps).
 class ObjectiveTerms {
@@ -74,8 +78,8 @@ class ObjectiveTerms {
   /// share: shared_structure_tv with spatial TV terms and two sharp frames at different times.
   bool has_spatial_tv_offsets() const { return !tv_offset_right_.empty(); }
   /// The offsets of pixel p's spatial TV differences: minmod(F_first(q) − F_first(p),
-  /// F_last(q) − F_last(p)) for q its right and lower neighbours (0 without a neighbour), or 0
-  /// when !has_spatial_tv_offsets().
+  /// F_last(q) − F_last(p)) for q its right and lower neighbours, rounded to
+  /// kSpatialTvOffsetStep (0 without a neighbour), or 0 when !has_spatial_tv_offsets().
   SpatialTvOffset spatial_tv_offset_at(int64_t p) const {
     if (!has_spatial_tv_offsets()) return {};
     return {tv_offset_right_[p], tv_offset_below_[p]};

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -221,17 +222,21 @@ TEST(ObjectiveTerms, SharedStructureOffsetsAreTheMinmodOfTheTwoFrames) {
   objective.shared_structure_tv = true;
   const ObjectiveTerms terms(scene, objective, mask);
   ASSERT_TRUE(terms.has_spatial_tv_offsets());
-  EXPECT_NEAR(terms.spatial_tv_offset_at(0).right, 0.1, 1e-12);
-  EXPECT_NEAR(terms.spatial_tv_offset_at(2).right, 0.1, 1e-12);
-  EXPECT_EQ(terms.spatial_tv_offset_at(kWidth + 1).right, 0.0);   // opposite signs
-  EXPECT_NEAR(terms.spatial_tv_offset_at(0).below, 0.2, 1e-12);   // 0.3 − 0.1 and 0.6 − 0.1
-  EXPECT_EQ(terms.spatial_tv_offset_at(kWidth - 1).right, 0.0);   // no right neighbour
-  EXPECT_EQ(terms.spatial_tv_offset_at(kPixels - 1).below, 0.0);  // no lower neighbour
+  // Rounded to the offset step: within half a step, and a whole number of steps.
+  constexpr double kHalfStep = kSpatialTvOffsetStep / 2;
+  EXPECT_NEAR(terms.spatial_tv_offset_at(0).right, 0.1, kHalfStep);
+  EXPECT_NEAR(terms.spatial_tv_offset_at(2).right, 0.1, kHalfStep);
+  const double steps = terms.spatial_tv_offset_at(2).right / kSpatialTvOffsetStep;
+  EXPECT_EQ(steps, std::round(steps));
+  EXPECT_EQ(terms.spatial_tv_offset_at(kWidth + 1).right, 0.0);      // opposite signs
+  EXPECT_NEAR(terms.spatial_tv_offset_at(0).below, 0.2, kHalfStep);  // 0.3 − 0.1 and 0.6 − 0.1
+  EXPECT_EQ(terms.spatial_tv_offset_at(kWidth - 1).right, 0.0);      // no right neighbour
+  EXPECT_EQ(terms.spatial_tv_offset_at(kPixels - 1).below, 0.0);     // no lower neighbour
   // A falling edge in both frames: the smaller fall.
   first(3, 0) = 0.9;
   last(3, 0) = 0.7;
   const ObjectiveTerms falling(scene, objective, mask);
-  EXPECT_NEAR(falling.spatial_tv_offset_at(3 * kWidth).right, 0.5 - 0.7, 1e-12);
+  EXPECT_NEAR(falling.spatial_tv_offset_at(3 * kWidth).right, 0.5 - 0.7, kHalfStep);
 }
 
 TEST(ObjectiveTerms, NoSharedStructureWithoutTwoSharpFrames) {
