@@ -364,6 +364,12 @@ void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& p
       {"spatial_tv_residuals", problem.spatial_tv_residuals},
       {"temporal_tv_residuals", problem.temporal_tv_residuals},
   };
+  if (options.objective.shared_structure_tv) {
+    json["problem"]["shared_structure_tv"] = {
+        {"frames_correlation", Number(problem.shared_structure_correlation)},
+        {"applied", problem.shared_structure_applied},
+    };
+  }
 }
 
 }  // namespace

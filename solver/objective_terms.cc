@@ -84,6 +84,23 @@ void ObjectiveTerms::ComputeSharedStructureOffsets(const Scene& scene) {
   };
   const double* f = first->image.data();
   const double* l = last->image.data();
+  // Whether the frames share structure at all: the correlation of their differences over the
+  // image. Where it is not positive their differences agree in sign by chance only.
+  double cross = 0.0, first_energy = 0.0, last_energy = 0.0;
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const int64_t p = static_cast<int64_t>(y) * width_ + x;
+      for (const int64_t q : {x + 1 < width_ ? p + 1 : p, y + 1 < height_ ? p + width_ : p}) {
+        const double a = f[q] - f[p], b = l[q] - l[p];
+        cross += a * b;
+        first_energy += a * a;
+        last_energy += b * b;
+      }
+    }
+  }
+  const double energy = std::sqrt(first_energy * last_energy);
+  shared_structure_correlation_ = energy > 0.0 ? cross / energy : 0.0;
+  if (!(shared_structure_correlation_ > 0.0)) return;
   const int64_t pixels = static_cast<int64_t>(height_) * width_;
   tv_offset_right_.assign(pixels, 0.0);
   tv_offset_below_.assign(pixels, 0.0);

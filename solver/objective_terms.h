@@ -75,8 +75,14 @@ class ObjectiveTerms {
   /// The spatial TV terms pixel p owns; none when the family has no terms.
   SpatialTvTermsAt spatial_tv_terms_at(int64_t p) const;
   /// Whether spatial TV is measured from the structure the scene's first and last sharp frames
-  /// share: shared_structure_tv with spatial TV terms and two sharp frames at different times.
+  /// share: shared_structure_tv with spatial TV terms, two sharp frames at different times, and
+  /// a positive shared_structure_correlation().
   bool has_spatial_tv_offsets() const { return !tv_offset_right_.empty(); }
+  /// With shared_structure_tv and two sharp frames: the correlation of the two frames' forward
+  /// differences over the image, Σ ∂F_first·∂F_last / sqrt(Σ ∂F_first² · Σ ∂F_last²) over both
+  /// axes. Where it is not positive the frames show nothing in place that chance would not (a
+  /// scene that moved more than its texture's scale) and TV stays plain. Else 0.
+  double shared_structure_correlation() const { return shared_structure_correlation_; }
   /// The offsets of pixel p's spatial TV differences: minmod(F_first(q) − F_first(p),
   /// F_last(q) − F_last(p)) for q its right and lower neighbours, rounded to
   /// kSpatialTvOffsetStep (0 without a neighbour), or 0 when !has_spatial_tv_offsets().
@@ -94,6 +100,7 @@ class ObjectiveTerms {
   std::array<double, kNumTermFamilies> weights_{};
   std::array<int64_t, kNumTermFamilies> counts_{};
   std::vector<double> tv_offset_right_, tv_offset_below_;  // per pixel; empty: plain TV
+  double shared_structure_correlation_ = 0.0;
 };
 
 }  // namespace evfs

@@ -89,6 +89,8 @@ ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) 
   active_pixels += part.active_pixels;
   skipped_pixels += part.skipped_pixels;
   parts += part.parts;
+  shared_structure_correlation = part.shared_structure_correlation;
+  shared_structure_applied = part.shared_structure_applied;
   return *this;
 }
 
@@ -470,6 +472,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
     }
   }
   statistics.distinct_cost_functions = static_cast<int64_t>(built->cost_functions_.size());
+  statistics.shared_structure_correlation = terms.shared_structure_correlation();
+  statistics.shared_structure_applied = terms.has_spatial_tv_offsets();
   return built;
 }
 

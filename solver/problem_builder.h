@@ -34,6 +34,9 @@ struct ProblemStatistics {
   int64_t parts = 1;            // problems built: independent parts, or bands of one
   int64_t batches = 1;          // groups of parts built and solved at once (ProblemPlan)
   int64_t estimated_bytes = 0;  // the plan's estimate for every part at once (not summed)
+  // ObjectiveTerms::shared_structure_correlation() and has_spatial_tv_offsets() (not summed).
+  double shared_structure_correlation = 0.0;
+  bool shared_structure_applied = false;
 
   int64_t residual_blocks() const {
     return frame_residuals + event_residuals + spatial_tv_residuals + temporal_tv_residuals +

@@ -238,7 +238,9 @@ TEST(FusedObjective, MatchesTheProblemWithSharedStructureTv) {
   // offsets of both signs and zeros), every form, one unknown per voxel and merged segments.
   for (const SpatialTv form : {SpatialTv::kPaper, SpatialTv::kAnisotropic, SpatialTv::kIsotropic}) {
     for (const bool merged : {false, true}) {
-      const Scene scene = MakeRandomScene(Binning::kCollision, Activity::kPartial, 51);
+      Scene scene = MakeRandomScene(Binning::kCollision, Activity::kPartial, 51);
+      // The last frame half the first: their differences correlate, so the offsets apply.
+      scene.frames.back().image = 0.5 * scene.frames.front().image;
       ReconstructionOptions options = MakeOptions(form, EventModel::kLog, Activity::kPartial);
       options.objective.shared_structure_tv = true;
       options.merge_quiet_steps = merged;

@@ -239,16 +239,37 @@ TEST(ObjectiveTerms, SharedStructureOffsetsAreTheMinmodOfTheTwoFrames) {
   EXPECT_NEAR(falling.spatial_tv_offset_at(3 * kWidth).right, 0.5 - 0.7, kHalfStep);
 }
 
+TEST(ObjectiveTerms, NoSharedStructureBetweenFramesThatShowNothingInPlace) {
+  // A bright pixel at (1, 1) in the first frame and at (2, 3) in the last: the frames'
+  // differences do not correlate (each frame's bump sits on the other's flat), so any sign
+  // agreement is chance and TV stays plain. The same bump in both frames correlates fully.
+  Scene scene = MakeScene({{1, 2, 3}});
+  scene.frames[0].image(1, 1) = 0.9;
+  scene.frames[1].image(2, 3) = 0.9;
+  const ActivityMask mask(scene.events, /*radius_px=*/-1);
+  ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+  objective.shared_structure_tv = true;
+  const ObjectiveTerms moved(scene, objective, mask);
+  EXPECT_LE(moved.shared_structure_correlation(), 0.0);
+  EXPECT_FALSE(moved.has_spatial_tv_offsets());
+  scene.frames[1].image(2, 3) = 0.6;
+  scene.frames[1].image(1, 1) = 1.3;  // the same bump (+0.7 over its surround) in place
+  const ObjectiveTerms in_place(scene, objective, mask);
+  EXPECT_NEAR(in_place.shared_structure_correlation(), 1.0, 1e-12);
+  EXPECT_TRUE(in_place.has_spatial_tv_offsets());
+}
+
 TEST(ObjectiveTerms, NoSharedStructureWithoutTwoSharpFrames) {
-  const Scene two_frames = MakeScene({{1, 2, 3}});
+  Scene two_frames = MakeScene({{1, 2, 3}});
+  two_frames.frames[0].image(1, 1) = two_frames.frames[1].image(1, 1) = 0.9;  // shared in place
   const ActivityMask mask(two_frames.events, /*radius_px=*/-1);
   ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
   objective.shared_structure_tv = true;
   EXPECT_TRUE(ObjectiveTerms(two_frames, objective, mask).has_spatial_tv_offsets());
-  Scene one_frame = MakeScene({{1, 2, 3}});  // a prediction: the first frame only
+  Scene one_frame = two_frames;  // a prediction: the first frame only
   one_frame.frames.pop_back();
   EXPECT_FALSE(ObjectiveTerms(one_frame, objective, mask).has_spatial_tv_offsets());
-  Scene blurred = MakeScene({{1, 2, 3}});  // the last frame blurred over the window
+  Scene blurred = two_frames;  // the last frame blurred over the window
   blurred.frames[1].latent_first = 0;
   EXPECT_FALSE(ObjectiveTerms(blurred, objective, mask).has_spatial_tv_offsets());
   objective.spatial_tv_weight = 0.0;  // no spatial TV: nothing to measure
