@@ -21,9 +21,9 @@ namespace {
 
 // Cost functions depend only on (family, observed value, shape), and observations take few
 // distinct values (events are {-1, 0, 1} or small counts, frames 8- or 16-bit levels, spatial TV
-// offsets differences of those), so one cost function per key serves every residual block that
-// shares it. The shape is the number of
-// steps of an event frame, or the run lengths of a frame observation's segments.
+// offsets multiples of kSpatialTvOffsetStep), so one cost function per key serves every residual
+// block that shares it. The shape is the number of steps of an event frame, or the run lengths
+// of a frame observation's segments.
 class CostFunctionCache {
  public:
   enum class Family { kFrame, kEvent, kSpatialTv, kTemporalTv };
@@ -394,8 +394,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
     const bool offsets = terms.has_spatial_tv_offsets();
     // One residual per run of latent frames over which the pixels it touches keep their
     // segments: the run's m identical terms, weighted m times.
-    const auto add_runs = [&](ceres::CostFunction* spatial_cost,
-                              std::initializer_list<int64_t> touched) {
+    const auto add_runs = [&](ceres::CostFunction* cost, std::initializer_list<int64_t> touched) {
       int run_first = 0;
       for (int t = 1; t <= num_latent; ++t) {
         bool same = t < num_latent;
@@ -405,7 +404,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
         if (same) continue;
         blocks.clear();
         for (const int64_t q : touched) blocks.push_back(block(run_first, q));
-        problem.AddResidualBlock(spatial_cost, losses.Get(weight, t - run_first), blocks);
+        problem.AddResidualBlock(cost, losses.Get(weight, t - run_first), blocks);
         ++statistics.spatial_tv_residuals;
         run_first = t;
       }
