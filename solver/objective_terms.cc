@@ -84,34 +84,31 @@ void ObjectiveTerms::ComputeSharedStructureOffsets(const Scene& scene) {
   };
   const double* f = first->image.data();
   const double* l = last->image.data();
+  const int64_t pixels = static_cast<int64_t>(height_) * width_;
+  tv_offset_right_.assign(pixels, 0.0);
+  tv_offset_below_.assign(pixels, 0.0);
   // Whether the frames share structure at all: the correlation of their differences over the
   // image. Where it is not positive their differences agree in sign by chance only.
   double cross = 0.0, first_energy = 0.0, last_energy = 0.0;
+  const auto difference = [&](int64_t p, int64_t q, double* offset) {
+    const double a = f[q] - f[p], b = l[q] - l[p];
+    cross += a * b;
+    first_energy += a * a;
+    last_energy += b * b;
+    *offset = minmod(a, b);
+  };
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
       const int64_t p = static_cast<int64_t>(y) * width_ + x;
-      for (const int64_t q : {x + 1 < width_ ? p + 1 : p, y + 1 < height_ ? p + width_ : p}) {
-        const double a = f[q] - f[p], b = l[q] - l[p];
-        cross += a * b;
-        first_energy += a * a;
-        last_energy += b * b;
-      }
+      if (x + 1 < width_) difference(p, p + 1, &tv_offset_right_[p]);
+      if (y + 1 < height_) difference(p, p + width_, &tv_offset_below_[p]);
     }
   }
   const double energy = std::sqrt(first_energy * last_energy);
   shared_structure_correlation_ = energy > 0.0 ? cross / energy : 0.0;
-  if (!(shared_structure_correlation_ > 0.0)) return;
-  const int64_t pixels = static_cast<int64_t>(height_) * width_;
-  tv_offset_right_.assign(pixels, 0.0);
-  tv_offset_below_.assign(pixels, 0.0);
-  for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) {
-      const int64_t p = static_cast<int64_t>(y) * width_ + x;
-      if (x + 1 < width_) tv_offset_right_[p] = minmod(f[p + 1] - f[p], l[p + 1] - l[p]);
-      if (y + 1 < height_) {
-        tv_offset_below_[p] = minmod(f[p + width_] - f[p], l[p + width_] - l[p]);
-      }
-    }
+  if (!(shared_structure_correlation_ > 0.0)) {
+    tv_offset_right_.clear();
+    tv_offset_below_.clear();
   }
 }
 

@@ -47,10 +47,11 @@ struct ObjectiveOptions {
   /// frames show in place: dx H − minmod(dx F_first, dx F_last), the same for dy, with minmod
   /// the smaller of the two where they have the same sign and 0 where not (ObjectiveTerms). A
   /// texture both frames show costs nothing to keep; an edge only one frame shows there is still
-  /// penalised. Scenes without two sharp frames keep plain TV. Off by default: it lifts the quiet
-  /// windows of issue 16 (GOPR9642 24, 28 → 26 by 1 dB) and the clips' interpolations on the
-  /// mean, but costs GOPR9642 0, 4 → 2 0.19 dB (BENCHMARKS.md, "Spatial TV of what the frames do
-  /// not share").
+  /// penalised. Scenes without two sharp frames, or whose two frames' differences do not
+  /// correlate positively (ObjectiveTerms::shared_structure_correlation), keep plain TV. Off by
+  /// default: it lifts the quiet windows of issue 16 (GOPR9642 24, 28 → 26 by 1 dB) and no
+  /// window the issue lists gets worse, but whole fast clips lose 0.05–0.08 dB (BENCHMARKS.md,
+  /// "Spatial TV of what the frames do not share").
   bool shared_structure_tv = false;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
