@@ -95,6 +95,7 @@ ProgramHelp MakeEvfsHelp() {
       {"split_independent_parts", "model", "reconstruct video"},
       {"max_problem_mb", "model", "reconstruct video"},
       {"quiet_blend_fraction", "model", "reconstruct video"},
+      {"step_ramp_px", "model", "reconstruct video"},
       // Ceres.
       {"linear_solver", "solver", "reconstruct video"},
       {"preconditioner", "solver", "reconstruct video"},

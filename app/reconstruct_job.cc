@@ -346,6 +346,7 @@ void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& p
       {"merge_quiet_steps", options.merge_quiet_steps},
       {"unfired_pixel_changes", options.unfired_pixel_changes},
       {"quiet_blend_fraction", Number(options.quiet_blend_fraction)},
+      {"step_ramp_px", Number(options.step_ramp_px)},
   };
   Json continuation = Json::array();
   for (const double scale : options.smoothing_continuation) continuation.push_back(Number(scale));
@@ -431,6 +432,7 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
     json["initial_cost"] = Number(run.initial_cost);
     json["final_cost"] = Number(run.final_cost);
     AddProblem(options, summary.problem, &json);
+    json["pixels"]["ramped_steps"] = summary.ramped_steps;
   }
   json["time_s"] = {
       {"read", Number(result.time.read_s)},   {"bin", Number(result.time.bin_s)},

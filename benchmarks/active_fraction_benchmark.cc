@@ -31,6 +31,9 @@ DEFINE_int32(repeats, 3, "Runs per fraction; the table gives medians.");
 DEFINE_bool(
     shared_structure_tv, evfs::ObjectiveOptions().shared_structure_tv,
     "Spatial TV measured from the structure both frames share (evfs --shared_structure_tv).");
+DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
+              "Steps ramped over the time the scene takes to move this many pixels "
+              "(evfs --step_ramp_px).");
 
 namespace evfs {
 namespace {
@@ -90,6 +93,7 @@ int Run() {
     std::vector<double> build_s, solve_s;
     ReconstructionOptions options;
     options.objective.shared_structure_tv = FLAGS_shared_structure_tv;
+    options.step_ramp_px = FLAGS_step_ramp_px;
     Reconstruction result;
     for (int r = 0; r < FLAGS_repeats; ++r) {
       const auto start = Clock::now();

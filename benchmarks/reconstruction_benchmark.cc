@@ -52,6 +52,8 @@ DEFINE_bool(merge_quiet_steps, evfs::ReconstructionOptions().merge_quiet_steps,
             "one unknown per quiet run of a pixel (false: per voxel).");
 DEFINE_bool(split_independent_parts, evfs::ReconstructionOptions().split_independent_parts,
             "solve uncoupled regions as separate concurrent problems (false: one problem).");
+DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
+              "steps ramped over the time the scene takes to move this many pixels.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once; <= 0: no limit.");
 DEFINE_string(init, "blend", "blend | events: where the solve starts.");
@@ -104,6 +106,7 @@ ReconstructionOptions Options() {
   options.merge_quiet_steps = FLAGS_merge_quiet_steps;
   options.split_independent_parts = FLAGS_split_independent_parts;
   options.max_problem_mb = FLAGS_max_problem_mb;
+  options.step_ramp_px = FLAGS_step_ramp_px;
   return options;
 }
 

@@ -177,6 +177,10 @@ DEFINE_double(quiet_blend_fraction, evfs::ReconstructionOptions().quiet_blend_fr
               "After the solve, pixels no event fired whose sharp frames differ by less than "
               "this fraction of one event's change take the time-weighted blend of the frames "
               "between them; 0: off.");
+DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
+              "After the solve, each step of a solved pixel becomes a ramp over the time the "
+              "scene takes to move this many pixels there (measured from the events), within "
+              "half of the segments on either side; 0: steps stay jumps.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once, estimated before building: "
              "larger problems are solved in batches of parts, or in overlapping bands of rows, "
@@ -406,6 +410,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   options.split_independent_parts = FLAGS_split_independent_parts;
   options.max_problem_mb = FLAGS_max_problem_mb;
   options.quiet_blend_fraction = FLAGS_quiet_blend_fraction;
+  options.step_ramp_px = FLAGS_step_ramp_px;
   options.smoothing_continuation =
       ParseNumberList(FLAGS_smoothing_continuation, "--smoothing_continuation");
 

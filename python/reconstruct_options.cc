@@ -208,6 +208,7 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       IntOption<R>("max_problem_mb", [](R& s) -> int64_t& { return Rec(s).max_problem_mb; }),
       DoubleOption<R>("quiet_blend_fraction",
                       [](R& s) -> double& { return Rec(s).quiet_blend_fraction; }),
+      DoubleOption<R>("step_ramp_px", [](R& s) -> double& { return Rec(s).step_ramp_px; }),
       // Ceres.
       {"linear_solver",
        [](const R& s) {

@@ -87,6 +87,8 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
   check.Check(min_part_pixels >= 1, "min_part_pixels must be at least 1")
       .Check(quiet_blend_fraction >= 0.0 && quiet_blend_fraction <= kMaxQuietBlendFraction,
              "quiet_blend_fraction must be in [0, 100]")
+      .Check(step_ramp_px >= 0.0 && step_ramp_px <= kMaxStepRampPx,
+             "step_ramp_px must be in [0, 1e6]")
       .Check(max_problem_mb <= kMaxProblemMb,
              "max_problem_mb must be at most " + std::to_string(kMaxProblemMb) + " (1 TiB)")
       .Valid(solver);

@@ -131,6 +131,16 @@ struct ReconstructionOptions {
   /// scenes"). Not applied with a prior (objective.prior_weight).
   double quiet_blend_fraction = 0.0;
   static constexpr double kMaxQuietBlendFraction = 100.0;
+
+  /// After the solve (merged quiet steps, the Ceres solvers), each step of a solved pixel
+  /// becomes a linear ramp over the time the scene takes to move this many pixels there, as the
+  /// events measure it, bounded by the middles of the segments on either side, so that every
+  /// segment keeps its mean and the sharp frames their values (solver/step_ramps.h). A pixel
+  /// integrates light over its area: an edge changes it over the time it takes to cross it,
+  /// not at one instant; 2 allows a pixel of blur besides (sweep: BENCHMARKS.md, "Steps as
+  /// ramps"). 0: steps stay jumps. Not applied with a prior (objective.prior_weight).
+  double step_ramp_px = 2.0;
+  static constexpr double kMaxStepRampPx = 1.0e6;
   static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;
 
   /// Ceres settings, all of them available to library users; the defaults below are set by

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/time.h"
+#include "solver/step_ramps.h"
 
 namespace evfs {
 namespace {
@@ -280,6 +281,8 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   summary.initial_cost = summary.ceres.initial_cost;
   summary.final_cost = summary.ceres.final_cost;
   plan.layout().Expand(&result->video);
+  summary.ramped_steps =
+      RampSteps(scene, plan.layout(), solve_options.step_ramp_px, &result->video);
 }
 
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
@@ -309,9 +312,12 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   // Continuation: each smoothing scale's solution starts the next, the objective's own last.
   std::vector<double> scales = options.smoothing_continuation;
   scales.push_back(solve_options.objective.smoothing_scale);
-  for (const double scale : scales) {
+  for (size_t i = 0; i < scales.size(); ++i) {
     ReconstructionOptions stage = solve_options;
-    stage.objective.smoothing_scale = scale;
+    stage.objective.smoothing_scale = scales[i];
+    // Steps are ramped once, on the answer; with a prior (plug & play's x-update) the solve's
+    // answer is the minimiser it asked for.
+    if (i + 1 < scales.size() || options.objective.prior_weight != 0.0) stage.step_ramp_px = 0.0;
     BuildAndSolve(scene, stage, callback, &result);
     if (!summary.solved) break;  // nothing to solve
   }

@@ -30,6 +30,8 @@ struct ReconstructionSummary {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   int iterations = 0;  // of the part that took most
+  /// Steps spread over a ramp (ReconstructionOptions::step_ramp_px).
+  int64_t ramped_steps = 0;
 };
 
 struct Reconstruction {
