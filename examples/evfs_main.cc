@@ -178,9 +178,10 @@ DEFINE_double(quiet_blend_fraction, evfs::ReconstructionOptions().quiet_blend_fr
               "this fraction of one event's change take the time-weighted blend of the frames "
               "between them; 0: off.");
 DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
-              "After the solve, each step of a solved pixel becomes a ramp over the time the "
-              "scene takes to move this many pixels there (measured from the events), within "
-              "half of the segments on either side; 0: steps stay jumps.");
+              "After the solve, each step of a solved pixel becomes a ramp that ends at the step "
+              "and lasts the time the scene takes to move this many pixels there (measured "
+              "from the events), begun no earlier than the middle of the segment before; 0: "
+              "steps stay jumps.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once, estimated before building: "
              "larger problems are solved in batches of parts, or in overlapping bands of rows, "

@@ -133,12 +133,13 @@ struct ReconstructionOptions {
   static constexpr double kMaxQuietBlendFraction = 100.0;
 
   /// After the solve (merged quiet steps, the Ceres solvers), each step of a solved pixel
-  /// becomes a linear ramp over the time the scene takes to move this many pixels there, as the
-  /// events measure it, bounded by the middles of the segments on either side, so that every
-  /// segment keeps its mean and the sharp frames their values (solver/step_ramps.h). A pixel
-  /// integrates light over its area: an edge changes it over the time it takes to cross it,
-  /// not at one instant; 2 allows a pixel of blur besides (sweep: BENCHMARKS.md, "Steps as
-  /// ramps"). 0: steps stay jumps. Not applied with a prior (objective.prior_weight).
+  /// becomes a linear ramp that ends at the step and lasts the time the scene takes to move
+  /// this many pixels there, as the events measure it, begun no earlier than the middle of the
+  /// segment before, so that the sharp frames keep their values (solver/step_ramps.h). A pixel
+  /// integrates light over its area, so an edge changes it over the time it takes to cross it,
+  /// and a sensor fires when a change is complete; 2 allows a pixel of blur besides the pixel's
+  /// width (sweep: BENCHMARKS.md, "Steps as ramps"). Steps inside a blurred frame's exposure
+  /// stay jumps. 0: steps stay jumps. Not applied with a prior (objective.prior_weight).
   double step_ramp_px = 2.0;
   static constexpr double kMaxStepRampPx = 1.0e6;
   static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;

@@ -149,26 +149,22 @@ int64_t RampSteps(const Scene& scene, const LatentLayout& layout, double ramp_px
       held = layout.segment(layout.segment_at(t, p)).constant;
     if (held) continue;  // a ring pixel keeps its initial values
     for (int t = 0; t < frames; ++t) before[t] = latent->frame_data(t)[p];
-    const double half_ramp = 0.5 * ramp_px * slope[p];
+    const double ramp = ramp_px * slope[p];
     int first = 0;  // first frame of the current segment
     while (first < frames) {
       const int64_t segment = layout.segment_at(first, p);
       const int last = layout.segment(segment).last;
       if (last + 1 >= frames) break;
-      const int next_last = layout.segment(layout.segment_at(last + 1, p)).last;
-      // The step between frames `last` and `last + 1`, spread over [step − h, step + h].
+      // The step between frames `last` and `last + 1` becomes a ramp over [begin, step]: it
+      // ends where the event says the change was complete.
       const double step = 0.5 * (times[last] + times[last + 1]);
-      const double h =
-          std::min({half_ramp, step - middle(first, last), middle(last + 1, next_last) - step});
+      const double begin = std::max(step - ramp, middle(first, last));
       const double change = before[last + 1] - before[last];
       bool touched = false;
-      if (h > 0.0 && change != 0.0 && !in_exposure[last]) {
-        for (int t = first; t <= next_last; ++t) {
-          const double done = std::clamp((times[t] - (step - h)) / (2.0 * h), 0.0, 1.0);
-          // Frames up to `last` held the value before the step, the others the one after.
-          const double offset = t <= last ? change * done : change * (done - 1.0);
-          if (offset == 0.0) continue;
-          latent->frame_data(t)[p] += offset;
+      if (begin < step && change != 0.0 && !in_exposure[last]) {
+        for (int t = first; t <= last; ++t) {
+          if (times[t] <= begin) continue;
+          latent->frame_data(t)[p] += change * (times[t] - begin) / (step - begin);
           touched = true;
         }
       }

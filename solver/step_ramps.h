@@ -17,17 +17,18 @@
 // EventTimeSlope() takes each fired pixel's median over its events.
 //
 // RampSteps() then replaces each step of a solved pixel, at the boundary between two of its
-// segments, by a linear ramp centred on the boundary over ramp_px · |∇t| — but never past the
-// middle of either segment, so that every segment keeps its mean over time (what the frame
-// terms of a blurred frame see), its value at its own middle, and every sharp frame's voxel
-// its value: the frames are met exactly as before.
+// segments, by a linear ramp that ends at the step and lasts ramp_px · |∇t|. A sensor fires when
+// the change since its last event reaches the threshold: at the event the change is complete,
+// before it the change was under way. The ramp never begins before the middle of the segment
+// before the step, so each segment holds its solved value over its first half, and every sharp
+// frame's voxel keeps its value: the frames are met exactly as before.
 //
-// Steps inside a blurred frame's exposure stay jumps. Deblurring asks for the sharpest latent
-// frames the blurred frame allows, and on the real eslnet_cups_blur recording ramps of even half
-// a pixel lower the latent frames' sharpness (variance of the Laplacian ×1e3, 6.94 → 6.33; 5.73
-// at 2 px) while re-blurring to the same 42.33 dB: nothing observed says the ramps are right
-// there, and the blurred frame's own check, its sharpness, says they cost (BENCHMARKS.md, "Steps
-// as ramps").
+// Steps inside a blurred frame's exposure stay jumps. A blurred frame observes the mean of the
+// latent frames over its exposure, which the solve fitted and a ramp would move, and deblurring
+// asks for the sharpest latent frames it allows: on the real eslnet_cups_blur recording even
+// ramps that kept every segment's mean (an earlier form, centred on the step) lowered the latent
+// frames' sharpness (variance of the Laplacian ×1e3, 6.94 → 5.73 at 2 px) at the same re-blur
+// PSNR (BENCHMARKS.md, "Steps as ramps").
 #ifndef EVFS_SOLVER_STEP_RAMPS_H_
 #define EVFS_SOLVER_STEP_RAMPS_H_
 
@@ -49,11 +50,11 @@ namespace evfs {
 /// one pixel per window).
 std::vector<double> EventTimeSlope(const Scene& scene);
 
-/// Spreads every step of every pixel the layout solves (segments held constant excepted) over a
-/// linear ramp of ramp_px · EventTimeSlope() centred on the step, bounded by the middles of the
-/// segments on either side; steps inside a blurred frame's exposure are left (above). `latent`
-/// holds the solved video, expanded (LatentLayout::Expand). Returns the number of steps ramped over
-/// at least one latent frame. ramp_px <= 0 changes nothing.
+/// Replaces every step of every pixel the layout solves (segments held constant excepted) by a
+/// linear ramp of ramp_px · EventTimeSlope() that ends at the step, begun no earlier than the
+/// middle of the segment before it; steps inside a blurred frame's exposure are left (above).
+/// `latent` holds the solved video, expanded (LatentLayout::Expand). Returns the number of steps
+/// ramped over at least one latent frame. ramp_px <= 0 changes nothing.
 int64_t RampSteps(const Scene& scene, const LatentLayout& layout, double ramp_px, Video* latent);
 
 }  // namespace evfs
