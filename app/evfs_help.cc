@@ -96,6 +96,7 @@ ProgramHelp MakeEvfsHelp() {
       {"max_problem_mb", "model", "reconstruct video"},
       {"quiet_blend_fraction", "model", "reconstruct video"},
       {"step_ramp_px", "model", "reconstruct video"},
+      {"meet_sharp_frames", "model", "reconstruct video"},
       // Ceres.
       {"linear_solver", "solver", "reconstruct video"},
       {"preconditioner", "solver", "reconstruct video"},

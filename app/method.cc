@@ -172,4 +172,12 @@ MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
   return result;
 }
 
+void ApplySharpFrameSeams(const Scene& scene, const MethodOptions& options, MethodResult* result) {
+  if (!options.reconstruction.meet_sharp_frames || !IsIterative(options.method) ||
+      !result->solved) {
+    return;
+  }
+  result->seams = MeetSharpFrames(scene, &result->video);
+}
+
 }  // namespace evfs

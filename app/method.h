@@ -22,6 +22,7 @@
 #include "solver/iteration_callback.h"
 #include "solver/reconstruction_options.h"
 #include "solver/reconstructor.h"
+#include "solver/sharp_frame_seams.h"
 
 namespace evfs {
 
@@ -106,6 +107,8 @@ struct MethodResult {
   std::vector<BaselineParameter> parameters;
   std::string threshold_source;  // baselines: how the contrast threshold was chosen
   std::vector<Checkpoint> checkpoints;
+  /// What ApplySharpFrameSeams() did (nothing before it runs).
+  SharpFrameSeams seams;
 };
 
 /// Runs `options.method` on `scene`. `progress` (may be empty) sees every iteration of an
@@ -115,6 +118,13 @@ struct MethodResult {
 MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
                        const IterationCallback& progress = nullptr, bool record_checkpoints = false,
                        const CheckpointTruth* truth = nullptr);
+
+/// The last stage of a reconstruction, after the solve and any denoiser (whose calibration
+/// reads how far the solve left the frames): with options.reconstruction.meet_sharp_frames and
+/// an iterative method that solved, every sharp frame's latent frame takes the frame's values
+/// and its offset fades out around it (MeetSharpFrames, solver/sharp_frame_seams.h);
+/// result->seams records it.
+void ApplySharpFrameSeams(const Scene& scene, const MethodOptions& options, MethodResult* result);
 
 }  // namespace evfs
 

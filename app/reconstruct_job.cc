@@ -256,6 +256,7 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
                                           truth_latent, &result.run.video);
     }
   }
+  ApplySharpFrameSeams(scene, request.method, &result.run);
   const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
 
@@ -347,6 +348,7 @@ void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& p
       {"unfired_pixel_changes", options.unfired_pixel_changes},
       {"quiet_blend_fraction", Number(options.quiet_blend_fraction)},
       {"step_ramp_px", Number(options.step_ramp_px)},
+      {"meet_sharp_frames", options.meet_sharp_frames},
   };
   Json continuation = Json::array();
   for (const double scale : options.smoothing_continuation) continuation.push_back(Number(scale));
@@ -433,6 +435,8 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
     json["final_cost"] = Number(run.final_cost);
     AddProblem(options, summary.problem, &json);
     json["pixels"]["ramped_steps"] = summary.ramped_steps;
+    json["pixels"]["sharp_frames_met"] = run.seams.frames_met;
+    json["pixels"]["sharp_frame_offset_rms"] = Number(run.seams.offset_rms);
   }
   json["time_s"] = {
       {"read", Number(result.time.read_s)},   {"bin", Number(result.time.bin_s)},

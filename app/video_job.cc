@@ -211,6 +211,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
         request.denoise.calibrate ? &scene : nullptr, nullptr, -1, &run.video);
     denoise_s = SecondsSince(denoise_start);
   }
+  ApplySharpFrameSeams(scene, context.method, &run);
   // A sharp observed frame is the output at its own time, unchanged.
   Video& latent = run.video;
   for (size_t k = 0; k < window.frames.size(); ++k) {

@@ -26,6 +26,7 @@
 #include "core/time.h"
 #include "events/simulator.h"
 #include "solver/reconstructor.h"
+#include "solver/sharp_frame_seams.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
 DEFINE_string(cases, "slider,shapes,cups,clips", "Comma-separated cases to run.");
@@ -269,8 +270,10 @@ std::vector<Row> RunClipInterpolation(const std::string& name, const SimulatedCl
   std::string initial_method;
   const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
                                            BaselineOptions(), &initial_method);
-  const Reconstruction result = Reconstruct(scene, Options(), &initial);
+  Reconstruction result = Reconstruct(scene, Options(), &initial);
   PrintWholeObjective(name, "interpolate", scene, result);
+  // As `evfs reconstruct` finishes (app/method.h ApplySharpFrameSeams).
+  if (Options().meet_sharp_frames && result.summary.solved) MeetSharpFrames(scene, &result.video);
   const int index = result.video.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame));
   const Image& truth = clip.frames.frame(kClipTruthFrame);
   const double blend_psnr = Psnr(InitializeLatentVideo(scene).frame(index), truth);

@@ -182,6 +182,10 @@ DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
               "and lasts the time the scene takes to move this many pixels there (measured "
               "from the events), begun no earlier than the middle of the segment before; 0: "
               "steps stay jumps.");
+DEFINE_bool(meet_sharp_frames, evfs::ReconstructionOptions().meet_sharp_frames,
+            "After the solve, each sharp frame's latent frame takes the frame's values, the "
+            "offset fading out half-way to the next observation (or at the window's end); false: "
+            "the solve's values.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once, estimated before building: "
              "larger problems are solved in batches of parts, or in overlapping bands of rows, "
@@ -412,6 +416,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   options.max_problem_mb = FLAGS_max_problem_mb;
   options.quiet_blend_fraction = FLAGS_quiet_blend_fraction;
   options.step_ramp_px = FLAGS_step_ramp_px;
+  options.meet_sharp_frames = FLAGS_meet_sharp_frames;
   options.smoothing_continuation =
       ParseNumberList(FLAGS_smoothing_continuation, "--smoothing_continuation");
 

@@ -209,6 +209,7 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
       DoubleOption<R>("quiet_blend_fraction",
                       [](R& s) -> double& { return Rec(s).quiet_blend_fraction; }),
       DoubleOption<R>("step_ramp_px", [](R& s) -> double& { return Rec(s).step_ramp_px; }),
+      BoolOption<R>("meet_sharp_frames", [](R& s) -> bool& { return Rec(s).meet_sharp_frames; }),
       // Ceres.
       {"linear_solver",
        [](const R& s) {

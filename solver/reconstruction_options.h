@@ -48,11 +48,11 @@ struct ObjectiveOptions {
   /// the smaller of the two where they have the same sign and 0 where not (ObjectiveTerms). A
   /// texture both frames show costs nothing to keep; an edge only one frame shows there is still
   /// penalised. Scenes without two sharp frames, or whose two frames' differences do not
-  /// correlate positively (ObjectiveTerms::shared_structure_correlation), keep plain TV. Off by
-  /// default: it lifts the quiet windows of issue 16 (GOPR9642 24, 28 → 26 by 1 dB) and no
-  /// window the issue lists gets worse, but whole fast clips lose 0.05–0.08 dB (BENCHMARKS.md,
-  /// "Spatial TV of what the frames do not share").
-  bool shared_structure_tv = false;
+  /// correlate positively (ObjectiveTerms::shared_structure_correlation), keep plain TV. On by
+  /// default: with the step ramps it lifts every quiet window of issue 16 above the blend and
+  /// event integration (GOPR9642 24, 28 → 26 by 1.1 dB) and no window the issue lists gets
+  /// worse (BENCHMARKS.md, "Spatial TV of what the frames do not share").
+  bool shared_structure_tv = true;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
   /// ρ: weight of a quadratic prior ρ/2 · mean over the solved voxels of (H_t(p) − T_t(p))²
@@ -141,6 +141,13 @@ struct ReconstructionOptions {
   /// width (sweep: BENCHMARKS.md, "Steps as ramps"). Steps inside a blurred frame's exposure
   /// stay jumps. 0: steps stay jumps. Not applied with a prior (objective.prior_weight).
   double step_ramp_px = 2.0;
+  /// The last stage of a reconstruction, after any denoiser (app/method.h
+  /// ApplySharpFrameSeams; Reconstruct() itself leaves the solve's answer): each sharp frame's
+  /// latent frame takes the frame's values and the offset fades out linearly in time to
+  /// half-way to the neighbouring observation (or the window's end). The solve leaves a frame's
+  /// latent frame where the event and TV terms balance, 35 dB from an exact frame on a slow
+  /// window, and the frames next to it inherit the offset (solver/sharp_frame_seams.h).
+  bool meet_sharp_frames = true;
   static constexpr double kMaxStepRampPx = 1.0e6;
   static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;
 

@@ -41,10 +41,13 @@ Image Frame(const std::string& folder, int t) {
   return ReadGreyImage((fs::path(folder) / "frames" / name).string());
 }
 
+// The denoiser's effect alone: without the sharp frames met after it (--meet_sharp_frames), the
+// output is the DMR's latent video minus the correction.
 std::string Reconstruct(const std::string& data, const std::string& out, const std::string& flags) {
   const CommandResult run =
       RunEvfs("reconstruct --data=" + data +
-              " --mode=interpolate --first=0 --last=2 --truth=1 --out=" + out + " " + flags);
+              " --mode=interpolate --first=0 --last=2 --truth=1 --out=" + out +
+              " --meet_sharp_frames=false " + flags);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   return out;
 }

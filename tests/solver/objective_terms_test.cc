@@ -216,6 +216,7 @@ TEST(ObjectiveTerms, SharedStructureOffsetsAreTheMinmodOfTheTwoFrames) {
   }
   const ActivityMask mask(scene.events, /*radius_px=*/-1);
   ObjectiveOptions objective = MakeObjective(SpatialTv::kAnisotropic);
+  objective.shared_structure_tv = false;
   EXPECT_FALSE(ObjectiveTerms(scene, objective, mask).has_spatial_tv_offsets());
   EXPECT_EQ(ObjectiveTerms(scene, objective, mask).spatial_tv_offset_at(0).right, 0.0);
 

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "events/scene_synthesizer.h"
+#include "events/simulator.h"
 #include "scene/scene.h"
 
 namespace evfs {
@@ -25,6 +27,36 @@ inline Scene MakeSceneWithEvents(int height, int width,
   scene.frames.push_back({Image::Constant(height, width, 0.2), 0, 0, "first"});
   scene.frames.push_back({Image::Constant(height, width, 0.6), 3, 3, "last"});
   return scene;
+}
+
+/// A smooth texture panning 6 px in 20 ms (300 px/s) under `num_shapes` moving shapes,
+/// rendered at 1 kHz, its events simulated with the simulator's defaults, and the
+/// interpolation scene between its first and last rendered frames (both sharp and exact).
+struct PanningTexture {
+  Video rendered;
+  Scene scene;
+};
+
+inline PanningTexture MakePanningTexture(int width, int height, int num_shapes, uint64_t seed) {
+  SceneOptions options;
+  options.width = width;
+  options.height = height;
+  options.duration_s = 0.02;
+  options.num_shapes = num_shapes;
+  options.background_speed_px_per_s = 300.0;
+  options.seed = seed;
+  PanningTexture texture;
+  texture.rendered = SceneSynthesizer(options).RenderAtRate(1000.0);
+  const EventStream events = SimulateEvents(texture.rendered, SimulatorOptions());
+  const auto sharp = [&](int t) {
+    TimedFrame frame;
+    frame.image = texture.rendered.frame(t);
+    frame.exposure_begin_ns = frame.exposure_end_ns = texture.rendered.timestamp_ns(t);
+    return frame;
+  };
+  texture.scene = MakeInterpolationScene(sharp(0), sharp(texture.rendered.num_frames() - 1), events,
+                                         BinningOptions());
+  return texture;
 }
 
 }  // namespace evfs

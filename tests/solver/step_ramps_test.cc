@@ -6,8 +6,6 @@
 #include <cstdio>
 
 #include "core/metrics.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
 #include "solver/reconstructor.h"
 #include "tests/solver/solver_test_scenes.h"
 
@@ -125,23 +123,10 @@ TEST(RampSteps, StepsInsideABlurredExposureStayJumps) {
 TEST(RampSteps, FollowASlowlyPanningTextureBetweenTwoFrames) {
   // A smooth texture panning 6 px in 20 ms: each pixel changes over several milliseconds, where
   // the step model puts its whole change at one event.
-  SceneOptions scene_options;
-  scene_options.width = 48;
-  scene_options.height = 40;
-  scene_options.duration_s = 0.02;
-  scene_options.num_shapes = 2;
-  scene_options.background_speed_px_per_s = 300.0;
-  scene_options.seed = 11;
-  const Video rendered = SceneSynthesizer(scene_options).RenderAtRate(1000.0);
-  const EventStream events = SimulateEvents(rendered, SimulatorOptions());
-  const auto sharp = [&](int t) {
-    TimedFrame frame;
-    frame.image = rendered.frame(t);
-    frame.exposure_begin_ns = frame.exposure_end_ns = rendered.timestamp_ns(t);
-    return frame;
-  };
+  const PanningTexture texture = MakePanningTexture(48, 40, 2, 11);
+  const Video& rendered = texture.rendered;
+  const Scene& scene = texture.scene;
   const int last = rendered.num_frames() - 1;
-  const Scene scene = MakeInterpolationScene(sharp(0), sharp(last), events, BinningOptions());
   ReconstructionOptions options;
   options.step_ramp_px = 0.0;
   const Reconstruction steps = Reconstruct(scene, options);

@@ -166,11 +166,12 @@ inline Reconstruction ExpectStableReconstruction(const StressScene& stress,
   const Video initial = InitializeLatentVideo(scene);
   const ReconstructionOptions built_options = WithAlpha(scene, options);
   ExpectFiniteCostAndGradient(scene, built_options, initial, label + " at the initialisation");
-  // The solver's answer: the quiet pixels' blend and the steps' ramps after it are not a
-  // minimiser of the objective.
+  // The solver's answer: the quiet pixels' blend, the steps' ramps and the sharp frames met
+  // after it are not a minimiser of the objective.
   ReconstructionOptions solve_options = options;
   solve_options.quiet_blend_fraction = 0.0;
   solve_options.step_ramp_px = 0.0;
+  solve_options.meet_sharp_frames = false;
   Reconstruction result = Reconstruct(scene, solve_options);
   const ReconstructionSummary& summary = result.summary;
   if (summary.solved) {
