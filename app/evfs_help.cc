@@ -70,6 +70,7 @@ ProgramHelp MakeEvfsHelp() {
       // Events into event frames (info shows the binning a reconstruction would get).
       {"binning", "binning", "info reconstruct video"},
       {"max_latent_frames", "binning", "info reconstruct video"},
+      {"min_latent_steps", "binning", "info reconstruct video"},
       {"max_latent_voxels", "binning", "info reconstruct video"},
       {"hot_pixel_factor", "binning", "info reconstruct video"},
       {"noise_filter_ms", "binning", "info reconstruct video"},

@@ -83,10 +83,13 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
       window.size() - positive, static_cast<long long>(activity.pixels_fired),
       100.0 * static_cast<double>(activity.pixels_fired) / static_cast<double>(plan.pixels),
       static_cast<long long>(plan.collision_frames), left_out.c_str());
-  std::fprintf(out, "binning     %s: %s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
+  const bool split = plan.method == BinningOptions::Method::kCollision &&
+                     plan.num_event_frames > plan.collision_frames;
+  std::fprintf(out,
+               "binning     %s: %s%s, %d event frames, %d latent frames (%lld of %lld voxels)\n",
                binning_flag.c_str(), NameOf(kBinningMethodNames, plan.method),
-               plan.num_event_frames, plan.num_latent_frames,
-               static_cast<long long>(plan.latent_voxels()),
+               split ? " split in time (--min_latent_steps)" : "", plan.num_event_frames,
+               plan.num_latent_frames, static_cast<long long>(plan.latent_voxels()),
                static_cast<long long>(binning.max_latent_voxels));
   // A change of overall brightness between the frames (flicker, exposure or gain) that no
   // event records is outside the per-pixel event model; this line shows it.

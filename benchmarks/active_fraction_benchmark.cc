@@ -32,6 +32,9 @@ DEFINE_int32(repeats, 3, "Runs per fraction; the table gives medians.");
 DEFINE_bool(
     shared_structure_tv, evfs::ObjectiveOptions().shared_structure_tv,
     "Spatial TV measured from the structure both frames share (evfs --shared_structure_tv).");
+DEFINE_int32(min_latent_steps, evfs::BinningOptions().min_latent_steps,
+             "Collision frames split until the window has this many latent steps "
+             "(evfs --min_latent_steps).");
 DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
               "Steps ramped over the time the scene takes to move this many pixels "
               "(evfs --step_ramp_px).");
@@ -89,8 +92,10 @@ int Run() {
     const Video video = BandVideo(fraction);
     const EventStream events = SimulateEvents(video, SimulatorOptions());
     const int last = video.num_frames() - 1, middle = last / 2;
+    BinningOptions binning;
+    binning.min_latent_steps = FLAGS_min_latent_steps;
     const Scene scene =
-        MakeInterpolationScene(Sharp(video, 0), Sharp(video, last), events, BinningOptions());
+        MakeInterpolationScene(Sharp(video, 0), Sharp(video, last), events, binning);
     std::vector<double> build_s, solve_s;
     ReconstructionOptions options;
     options.objective.shared_structure_tv = FLAGS_shared_structure_tv;

@@ -80,26 +80,34 @@ int PixelIndex(const EventStream& events, size_t i) {
   return static_cast<int>(events.y(i)) * events.width() + events.x(i);
 }
 
-}  // namespace
-
-int64_t CountCollisionFrames(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns) {
-  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "CountCollisionFrames");
-  if (range.first == range.last) return 0;
-  // The walk of BinByCollision without the frames: last_fired[p] is the last frame pixel p fired
-  // in (-1: none yet).
+/// The paper's collision walk over the events of `range`: calls frame_opened(i) with the index
+/// of the event that opens each collision frame and returns their number. last_fired[p] is the
+/// last frame in which pixel p fired (-1: none yet); frame indices only grow, so comparing with
+/// the current one replaces clearing (one int32 per pixel, O(events) time).
+template <typename FrameOpened>
+int64_t WalkCollisionFrames(const EventStream& events, const WindowRange& range,
+                            FrameOpened frame_opened) {
   std::vector<int32_t> last_fired(static_cast<size_t>(events.width()) * events.height(), -1);
   int32_t current = -1;
   for (size_t i = range.first; i < range.last; ++i) {
     const int pixel = PixelIndex(events, i);
     if (current < 0 || last_fired[pixel] == current) {
       if (current == std::numeric_limits<int32_t>::max() - 1) {
-        throw InvalidArgumentError("CountCollisionFrames: more than 2^31 collision frames");
+        throw InvalidArgumentError("binning: more than 2^31 collision frames");
       }
+      frame_opened(i);
       ++current;
     }
     last_fired[pixel] = current;
   }
   return static_cast<int64_t>(current) + 1;
+}
+
+}  // namespace
+
+int64_t CountCollisionFrames(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns) {
+  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "CountCollisionFrames");
+  return WalkCollisionFrames(events, range, [](size_t) {});
 }
 
 PixelActivity MeasurePixelActivity(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
@@ -160,39 +168,88 @@ EventStream WithoutPixels(const EventStream& events, const std::vector<int32_t>&
   return kept;
 }
 
-EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns) {
-  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "BinByCollision");
-  EventFrames frames(events.height(), events.width());
-  std::vector<int64_t> latent_timestamps_ns = {t_begin_ns};
+int64_t CollisionLatentSteps(int64_t collision_frames, int64_t min_latent_steps,
+                             int64_t window_ns) {
+  if (collision_frames == 0) return 1;
+  return std::max(collision_frames, std::min(min_latent_steps, window_ns));
+}
 
-  // last_fired[p] is the index of the last frame in which pixel p fired (-1: none yet). Frame
-  // indices only grow, so comparing with the current index replaces clearing every frame.
-  std::vector<int32_t> last_fired(static_cast<size_t>(frames.pixels_per_frame()), -1);
-  int32_t current = -1;
-  float* values = nullptr;
-  for (size_t i = range.first; i < range.last; ++i) {
-    const int64_t t_ns = events.t_ns(i);
-    const int pixel = PixelIndex(events, i);
-    if (current < 0 || last_fired[pixel] == current) {
-      if (current >= 0) {
-        latent_timestamps_ns.push_back(MidpointRoundedUp(frames.span(current).t_last_ns, t_ns));
-      }
-      EventFrameSpan span;
-      span.latent_first = current + 1;
-      span.latent_last = current + 2;
-      span.t_first_ns = t_ns;
-      span.t_last_ns = t_ns;
-      current = frames.AddFrame(span);
-      values = frames.frame_data(current);  // AddFrame may have moved the storage
-    }
-    last_fired[pixel] = current;
-    values[pixel] = static_cast<float>(events.polarity(i));
-    EventFrameSpan& span = frames.span(current);
-    span.t_last_ns = t_ns;
-    ++span.num_events;
+EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                           int64_t min_latent_steps) {
+  const WindowRange range = CheckedWindow(events, t_begin_ns, t_end_ns, "BinByCollision");
+  // The collision frames first, as the index of each one's first event.
+  std::vector<size_t> frame_first;
+  WalkCollisionFrames(events, range, [&](size_t i) { frame_first.push_back(i); });
+  const size_t num_collision = frame_first.size();
+  frame_first.push_back(range.last);
+  std::vector<int64_t> boundaries_ns = {t_begin_ns};
+  for (size_t k = 1; k < num_collision; ++k) {
+    boundaries_ns.push_back(
+        MidpointRoundedUp(events.t_ns(frame_first[k] - 1), events.t_ns(frame_first[k])));
   }
+  boundaries_ns.push_back(t_end_ns);
+  MakeStrictlyIncreasing(&boundaries_ns, 1, "BinByCollision");
+
+  // Parts per collision frame: one each, then one more at a time to the frame whose parts are
+  // longest, while a part can still be 1 ns.
+  std::vector<int64_t> parts(num_collision, 1);
+  const int64_t num_steps = CollisionLatentSteps(static_cast<int64_t>(num_collision),
+                                                 min_latent_steps, t_end_ns - t_begin_ns);
+  if (num_collision > 0 && num_steps > static_cast<int64_t>(num_collision)) {
+    auto part_ns = [&](size_t k) {
+      return static_cast<double>(boundaries_ns[k + 1] - boundaries_ns[k]) /
+             static_cast<double>(parts[k]);
+    };
+    auto shorter = [&](size_t a, size_t b) { return part_ns(a) < part_ns(b); };
+    std::vector<size_t> heap(num_collision);
+    for (size_t k = 0; k < num_collision; ++k) heap[k] = k;
+    std::make_heap(heap.begin(), heap.end(), shorter);
+    for (int64_t added = static_cast<int64_t>(num_collision); added < num_steps && !heap.empty();) {
+      std::pop_heap(heap.begin(), heap.end(), shorter);
+      const size_t k = heap.back();
+      heap.pop_back();
+      if (parts[k] >= boundaries_ns[k + 1] - boundaries_ns[k]) continue;  // 1 ns parts already
+      ++parts[k];
+      ++added;
+      heap.push_back(k);
+      std::push_heap(heap.begin(), heap.end(), shorter);
+    }
+  }
+
+  EventFrames frames(events.height(), events.width());
+  std::vector<int64_t> latent_timestamps_ns;
+  latent_timestamps_ns.reserve(static_cast<size_t>(num_steps) + 1);
+  const auto t_first_it = events.t_ns().begin();
+  for (size_t k = 0; k < num_collision; ++k) {
+    const int64_t frame_ns = boundaries_ns[k + 1] - boundaries_ns[k];
+    size_t first = frame_first[k];
+    for (int64_t j = 0; j < parts[k]; ++j) {
+      const int64_t part_begin_ns = boundaries_ns[k] + FloorFraction(frame_ns, j, parts[k]);
+      const int64_t part_end_ns = boundaries_ns[k] + FloorFraction(frame_ns, j + 1, parts[k]);
+      // The frame's own events only (a collision decides the frame, not the time), the last
+      // part taking the rest.
+      const size_t last =
+          j + 1 == parts[k]
+              ? frame_first[k + 1]
+              : static_cast<size_t>(std::lower_bound(t_first_it + first,
+                                                     t_first_it + frame_first[k + 1], part_end_ns) -
+                                    t_first_it);
+      EventFrameSpan span;
+      span.latent_first = static_cast<int>(latent_timestamps_ns.size());
+      span.latent_last = span.latent_first + 1;
+      span.num_events = static_cast<int64_t>(last - first);
+      span.t_first_ns = span.num_events > 0 ? events.t_ns(first) : part_begin_ns;
+      span.t_last_ns = span.num_events > 0 ? events.t_ns(last - 1) : part_begin_ns;
+      float* values = frames.frame_data(frames.AddFrame(span));
+      for (size_t i = first; i < last; ++i) {
+        values[PixelIndex(events, i)] = static_cast<float>(events.polarity(i));
+      }
+      latent_timestamps_ns.push_back(part_begin_ns);
+      first = last;
+    }
+  }
+  if (latent_timestamps_ns.empty()) latent_timestamps_ns.push_back(t_begin_ns);
   latent_timestamps_ns.push_back(t_end_ns);
-  MakeStrictlyIncreasing(&latent_timestamps_ns, 1, "BinByCollision");
   frames.set_latent_timestamps_ns(std::move(latent_timestamps_ns));
   return frames;
 }

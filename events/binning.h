@@ -28,10 +28,28 @@ namespace evfs {
 ///
 /// O(number of events) time: a per-pixel index of the last frame that fired replaces clearing.
 ///
+/// min_latent_steps > N splits the collision frames in time until the window has that many
+/// latent steps (a window without events is not split): each collision frame k gets n_k >= 1
+/// equal parts, chosen greedily to make the longest part as short as possible (Σ n_k =
+/// min_latent_steps, a part at least 1 ns), and each event goes to the part of its frame that
+/// holds its time. A part of a collision frame is itself collision-free, so the frames still hold
+/// {-1, 0, +1}; parts without events are empty frames. Where events are few the collision
+/// frames are long (a window in which barely a pixel fires twice is a handful of steps), and
+/// every reconstruction on that timeline is a step function at that coarse a resolution: its
+/// changes land up to a step away from the events' times, and a frame asked for between two
+/// latent frames is read from the nearer one. The split puts the latent frames where the events
+/// are without adding a collision.
+///
 /// Throws InvalidArgumentError when t_end_ns <= t_begin_ns, when the events are not sorted or
 /// lie outside the sensor, or when the window has fewer nanoseconds than collision frames (only
 /// possible when one pixel fires repeatedly at the same timestamp).
-EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns);
+EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_t t_end_ns,
+                           int64_t min_latent_steps = 0);
+
+/// The latent steps BinByCollision gives for `collision_frames` collision frames in a window of
+/// window_ns nanoseconds and min_latent_steps: without events 1, else max(collision_frames,
+/// min_latent_steps), at most one per nanosecond.
+int64_t CollisionLatentSteps(int64_t collision_frames, int64_t min_latent_steps, int64_t window_ns);
 
 /// The number of event frames BinByCollision(events, t_begin_ns, t_end_ns) gives, counted
 /// without allocating a frame (O(events) time, one int32 per pixel), so that a caller can decide

@@ -112,6 +112,9 @@ DEFINE_string(binning, "auto",
 DEFINE_int32(max_latent_frames, evfs::BinningOptions().max_latent_frames,
              "auto binning: most latent steps before switching to "
              "stacked equal-time binning with this many frames.");
+DEFINE_int32(min_latent_steps, evfs::BinningOptions().min_latent_steps,
+             "auto binning: collision frames split in time until the window has this many "
+             "latent steps (within --max_latent_frames and --max_latent_voxels); 0: as they are.");
 DEFINE_int64(max_latent_voxels, evfs::BinningOptions().max_latent_voxels,
              "Most pixels x latent frames, decided from event counts before anything is "
              "allocated; bounds memory and time (auto binning takes as many steps as fit).");
@@ -288,6 +291,7 @@ BinningOptions BinningFromFlags() {
   BinningOptions binning;
   binning.method = ParseName(kBinningMethodNames, FLAGS_binning, "--binning");
   binning.max_latent_frames = FLAGS_max_latent_frames;
+  binning.min_latent_steps = FLAGS_min_latent_steps;
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
   binning.noise_filter_ms = FLAGS_noise_filter_ms;

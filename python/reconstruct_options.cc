@@ -155,6 +155,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
                     [](R& s) -> BinningOptions::Method& { return s.request.binning.method; }),
       IntOption<R>("max_latent_frames",
                    [](R& s) -> int& { return s.request.binning.max_latent_frames; }),
+      IntOption<R>("min_latent_steps",
+                   [](R& s) -> int& { return s.request.binning.min_latent_steps; }),
       IntOption<R>("max_latent_voxels",
                    [](R& s) -> int64_t& { return s.request.binning.max_latent_voxels; }),
       DoubleOption<R>("hot_pixel_factor",

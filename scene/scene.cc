@@ -76,6 +76,7 @@ BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t e
       }
       if (plan.collision_frames <= max_steps) {
         plan.method = BinningOptions::Method::kCollision;
+        plan.min_latent_steps = std::min<int64_t>(binning.min_latent_steps, max_steps);
       } else {
         plan.method = BinningOptions::Method::kStacked;
         plan.stacked.num_frames = static_cast<int>(max_steps);
@@ -86,8 +87,10 @@ BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t e
     }
   }
   if (plan.method == BinningOptions::Method::kCollision) {
-    plan.num_event_frames = static_cast<int>(plan.collision_frames);
-    plan.num_latent_frames = static_cast<int>(collision_latent_frames);
+    const int64_t steps =
+        CollisionLatentSteps(plan.collision_frames, plan.min_latent_steps, end_ns - begin_ns);
+    plan.num_event_frames = plan.collision_frames > 0 ? static_cast<int>(steps) : 0;
+    plan.num_latent_frames = static_cast<int>(steps) + 1;
   } else {
     plan.num_event_frames = plan.stacked.num_frames;
     plan.num_latent_frames = plan.stacked.num_frames * plan.stacked.steps_per_frame + 1;
@@ -111,6 +114,7 @@ bool BinningOptions::IsValid(std::string* error) const {
   check
       .Check(max_latent_frames >= 1 && max_latent_voxels >= 1,
              "max_latent_frames and max_latent_voxels must be at least 1")
+      .NonNegative("min_latent_steps", min_latent_steps)
       .NonNegative("hot_pixel_factor", hot_pixel_factor)
       .Check(noise_filter_ms >= 0.0 && noise_filter_ms <= kMaxNoiseFilterMs,
              "noise_filter_ms must lie in [0, 3600000] (an hour)");
@@ -146,9 +150,10 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
   const EventStream* binned = nullptr;
   const BinningPlan plan =
       PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept, &binned);
-  scene.events = plan.method == BinningOptions::Method::kCollision
-                     ? BinByCollision(*binned, window_begin_ns, window_end_ns)
-                     : BinStacked(*binned, window_begin_ns, window_end_ns, plan.stacked);
+  scene.events =
+      plan.method == BinningOptions::Method::kCollision
+          ? BinByCollision(*binned, window_begin_ns, window_end_ns, plan.min_latent_steps)
+          : BinStacked(*binned, window_begin_ns, window_end_ns, plan.stacked);
   for (const EventFrameSpan& span : scene.events.spans()) scene.num_events += span.num_events;
   scene.hot_pixels = plan.activity.hot_pixels;
   scene.hot_pixel_events = plan.activity.hot_pixel_events;

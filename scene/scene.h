@@ -51,6 +51,11 @@ struct BinningOptions {
   /// kAuto: the most latent steps; above it, stacked equal-time binning with this many frames
   /// is used instead (memory and time grow linearly with latent frames).
   int max_latent_frames = 48;
+  /// kAuto with collision binning: where the collision frames give fewer latent steps than
+  /// this, each is split in time (BinByCollision's min_latent_steps) until the window has this
+  /// many, within max_latent_frames and max_latent_voxels; 0 or 1 keeps the collision frames as
+  /// they are. An explicit kCollision is never split.
+  int min_latent_steps = 16;
   /// Every method: the most latent voxels (pixels × latent frames). kAuto gives larger sensors
   /// fewer steps (as many as fit, at least 1); kCollision and kStacked beyond it are refused.
   /// 12 M keeps all 48 steps up to 500×500, where fewer steps cost accuracy, within the memory
@@ -85,6 +90,7 @@ struct BinningPlan {
   int num_latent_frames = 2;
   int64_t pixels = 0;            // of the sensor
   int64_t collision_frames = 0;  // what collision binning gives, hot pixels left out
+  int64_t min_latent_steps = 0;  // kCollision: BinByCollision's split (0: none)
   PixelActivity activity;        // hot pixels and counts, before leaving any out
   int64_t noise_events = 0;      // left out by the background-activity filter
 

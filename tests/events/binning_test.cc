@@ -93,7 +93,8 @@ void ExpectIdentical(const EventFrames& a, const EventFrames& b) {
   }
 }
 
-TEST(BinByCollision, HandComputedSmallCase) {
+/// Three collision frames in [0, 100): [0, 25), [25, 45), [45, 100).
+EventStream SmallCaseEvents() {
   EventStream events(3, 2);
   events.push_back(10, 0, 0, 1);   // frame 0
   events.push_back(20, 1, 0, -1);  // frame 0
@@ -102,6 +103,11 @@ TEST(BinByCollision, HandComputedSmallCase) {
   events.push_back(50, 0, 0, 1);   // (0,0) fired in frame 1: opens frame 2
   events.push_back(60, 1, 0, 1);   // (1,0) last fired in frame 0: stays in frame 2
   events.push_back(100, 2, 1, 1);  // at the exclusive window end: not binned
+  return events;
+}
+
+TEST(BinByCollision, HandComputedSmallCase) {
+  const EventStream events = SmallCaseEvents();
   const EventFrames frames = BinByCollision(events, 0, 100);
 
   ASSERT_EQ(frames.num_frames(), 3);
@@ -194,6 +200,79 @@ TEST(BinByCollision, CoincidentBoundariesAreNudgedApartByOneNanosecond) {
 
   // Five latent steps cannot fit in a window of two nanoseconds.
   EXPECT_THROW(BinByCollision(events, 50, 52), InvalidArgumentError);
+}
+
+TEST(BinByCollision, SplitsTheLongestCollisionFramesUntilTheWindowHasTheStepsAskedFor) {
+  const EventStream events = SmallCaseEvents();
+  // Six steps: the 55 ns frame gets a second part (27.5 ns), then a third (18.3 ns), then the
+  // 25 ns frame a second (12.5 ns), which leaves the 20 ns frame the longest part.
+  const EventFrames frames = BinByCollision(events, 0, 100, 6);
+  ASSERT_EQ(frames.num_frames(), 6);
+  EXPECT_EQ(frames.latent_timestamps_ns(), (std::vector<int64_t>{0, 12, 25, 45, 63, 81, 100}));
+  const int64_t expected_events[6] = {1, 1, 2, 2, 0, 0};
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(frames.span(k).latent_first, k);
+    EXPECT_EQ(frames.span(k).latent_last, k + 1);
+    EXPECT_EQ(frames.span(k).num_events, expected_events[k]) << "frame " << k;
+  }
+  EXPECT_EQ(frames.value(0, 0, 0), 1.0f);
+  EXPECT_EQ(frames.value(1, 0, 1), -1.0f);
+  EXPECT_EQ(frames.value(2, 0, 0), -1.0f);
+  EXPECT_EQ(frames.value(2, 1, 1), 1.0f);
+  EXPECT_EQ(frames.value(3, 0, 0), 1.0f);
+  EXPECT_EQ(frames.value(3, 0, 1), 1.0f);
+  // An empty part sits at its own start.
+  EXPECT_EQ(frames.span(4).t_first_ns, 63);
+  EXPECT_EQ(frames.span(5).t_last_ns, 81);
+  ExpectValidTimeline(frames, 0, 100);
+  // Asking for no more steps than the collision frames give changes nothing.
+  ExpectIdentical(BinByCollision(events, 0, 100, 3), BinByCollision(events, 0, 100));
+}
+
+TEST(BinByCollision, SplitFramesStayCollisionFreeAndKeepTheCollisionBoundaries) {
+  const EventStream events = RandomEvents(300, 0, 1000000, kSeed);
+  const EventFrames plain = BinByCollision(events, 100000, 900000);
+  const int steps = plain.num_frames() * 3 + 7;
+  const EventFrames split = BinByCollision(events, 100000, 900000, steps);
+  ASSERT_EQ(split.num_frames(), steps);
+  EXPECT_EQ(CollisionLatentSteps(plain.num_frames(), steps, 800000), steps);
+  for (int k = 0; k < split.num_frames(); ++k) {
+    int64_t nonzero = 0;
+    for (int64_t p = 0; p < split.pixels_per_frame(); ++p) {
+      EXPECT_LE(std::abs(split.frame_data(k)[p]), 1.0f);
+      nonzero += split.frame_data(k)[p] != 0.0f;
+    }
+    EXPECT_EQ(nonzero, split.span(k).num_events) << "frame " << k;
+  }
+  EXPECT_EQ(FrameSums(split), FrameSums(plain));
+  const std::vector<int64_t>& fine = split.latent_timestamps_ns();
+  for (const int64_t t : plain.latent_timestamps_ns()) {
+    EXPECT_TRUE(std::binary_search(fine.begin(), fine.end(), t)) << t;
+  }
+  ExpectValidTimeline(split, 100000, 900000);
+  // The parts are as even as whole frames allow: none is twice the shortest frame's part.
+  int64_t longest = 0;
+  for (size_t k = 0; k + 1 < fine.size(); ++k) longest = std::max(longest, fine[k + 1] - fine[k]);
+  EXPECT_LE(longest, 2 * 800000 / steps + 1);
+}
+
+TEST(BinByCollision, AWindowWithoutEventsIsNotSplit) {
+  const EventStream events = RandomEvents(100, 0, 1000, kSeed);
+  const EventFrames frames = BinByCollision(events, 5000, 6000, 16);
+  EXPECT_EQ(frames.num_frames(), 0);
+  EXPECT_EQ(frames.latent_timestamps_ns(), (std::vector<int64_t>{5000, 6000}));
+  EXPECT_EQ(CollisionLatentSteps(0, 16, 1000), 1);
+}
+
+TEST(BinByCollision, PartsAreNeverShorterThanOneNanosecond) {
+  EventStream events(2, 1);
+  events.push_back(1, 0, 0, 1);
+  events.push_back(2, 0, 0, -1);
+  const EventFrames frames = BinByCollision(events, 0, 4, 100);
+  EXPECT_EQ(frames.latent_timestamps_ns(), (std::vector<int64_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(CollisionLatentSteps(2, 100, 4), 4);
+  EXPECT_DOUBLE_EQ(frames.TotalAbsoluteValue(), 2.0);
+  ExpectValidTimeline(frames, 0, 4);
 }
 
 TEST(BinByCollision, RejectsBadWindowsAndEvents) {

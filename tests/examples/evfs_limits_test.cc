@@ -102,6 +102,30 @@ TEST(EvfsLimits, HotPixelIsLeftOutAndReported) {
                   "hot_pixel_factor", scratch + "/never");
 }
 
+// Few collision frames are split in time up to --min_latent_steps, and `info` says so; an
+// explicit --binning=collision keeps them.
+TEST(EvfsLimits, InfoReportsCollisionFramesSplitInTime) {
+  const std::string scratch = test::ScratchDir("limits_split");
+  const std::string data = WriteHotPixelFolder(scratch, 1000);
+  const std::string window = "info --data=" + data + " --first=0 --last=1";
+  const CommandResult plain = RunLimited(window + " --min_latent_steps=0");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_NE(plain.output.find("binning     auto: collision, "), std::string::npos) << plain.output;
+  const CommandResult split = RunLimited(window + " --min_latent_steps=40");
+  ASSERT_EQ(split.exit_code, 0) << split.output;
+  EXPECT_NE(split.output.find("binning     auto: collision split in time (--min_latent_steps), "
+                              "40 event frames, 41 latent frames"),
+            std::string::npos)
+      << split.output;
+  const CommandResult explicit_collision =
+      RunLimited(window + " --min_latent_steps=40 --binning=collision");
+  ASSERT_EQ(explicit_collision.exit_code, 0) << explicit_collision.output;
+  EXPECT_NE(explicit_collision.output.find("binning     collision: collision, "), std::string::npos)
+      << explicit_collision.output;
+  ExpectUserError(RunLimited(window + " --min_latent_steps=-1"), "min_latent_steps",
+                  scratch + "/never");
+}
+
 // Regression (issue 14): --max_latent_voxels bounded auto binning only, after the collision
 // frames were allocated; an explicit --binning beyond it was built whatever its size. It is
 // now a user error in every mode and in `info`, before anything is allocated.

@@ -192,6 +192,34 @@ TEST(Scene, PlanBinningPredictsTheScene) {
   }
 }
 
+// Few collision frames: auto binning splits them up to min_latent_steps (never beyond
+// max_latent_frames), an explicit --binning=collision keeps the paper's frames.
+TEST(Scene, AutoBinningSplitsFewCollisionFramesUpToMinLatentSteps) {
+  const test::SyntheticRecording recording;
+  const int64_t begin_ns = recording.rendered.timestamp_ns(0);
+  const int64_t end_ns = recording.rendered.timestamp_ns(1);
+  const int64_t collisions = CountCollisionFrames(recording.events, begin_ns, end_ns);
+  ASSERT_GT(collisions, 0);
+  for (const auto method : {BinningOptions::Method::kAuto, BinningOptions::Method::kCollision}) {
+    for (const int64_t extra : {0, 5}) {
+      BinningOptions binning;
+      binning.method = method;
+      binning.max_latent_frames = static_cast<int>(collisions + 3);
+      binning.min_latent_steps = static_cast<int>(collisions + extra);
+      const BinningPlan plan = PlanBinning(recording.events, begin_ns, end_ns, binning);
+      const Scene scene =
+          MakePredictionScene(recording.Sharp(0), end_ns, recording.events, binning);
+      const int64_t expected = method == BinningOptions::Method::kAuto
+                                   ? collisions + std::min<int64_t>(extra, 3)
+                                   : collisions;
+      EXPECT_EQ(plan.method, BinningOptions::Method::kCollision);
+      EXPECT_EQ(scene.num_latent_frames(), expected + 1) << "extra " << extra;
+      EXPECT_EQ(plan.num_latent_frames, scene.num_latent_frames());
+      EXPECT_EQ(scene.num_events, plan.activity.num_events);
+    }
+  }
+}
+
 // Regression (issue 14): one pixel firing a thousand times in a quiet window made collision
 // binning open a thousand frames of the whole sensor (auto binning then fell back to stacked
 // frames). Its events are now left out as hot, and the scene is the one without it.
