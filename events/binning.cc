@@ -80,6 +80,28 @@ int PixelIndex(const EventStream& events, size_t i) {
   return static_cast<int>(events.y(i)) * events.width() + events.x(i);
 }
 
+/// The index of the first event in [first, last) at or after t_ns (the events sorted by time).
+size_t FirstAtOrAfter(const EventStream& events, size_t first, size_t last, int64_t t_ns) {
+  const auto begin = events.t_ns().begin();
+  return static_cast<size_t>(std::lower_bound(begin + first, begin + last, t_ns) - begin);
+}
+
+/// Appends the event frame of events [first, last), spanning latent frames latent_first …
+/// latent_last: each pixel holds the sum of its polarities. An empty frame is timed at empty_ns.
+void AppendEventFrame(const EventStream& events, size_t first, size_t last, int latent_first,
+                      int latent_last, int64_t empty_ns, EventFrames* frames) {
+  EventFrameSpan span;
+  span.latent_first = latent_first;
+  span.latent_last = latent_last;
+  span.num_events = static_cast<int64_t>(last - first);
+  span.t_first_ns = span.num_events > 0 ? events.t_ns(first) : empty_ns;
+  span.t_last_ns = span.num_events > 0 ? events.t_ns(last - 1) : empty_ns;
+  float* values = frames->frame_data(frames->AddFrame(span));
+  for (size_t i = first; i < last; ++i) {
+    values[PixelIndex(events, i)] += static_cast<float>(events.polarity(i));
+  }
+}
+
 /// The paper's collision walk over the events of `range`: calls frame_opened(i) with the index
 /// of the event that opens each collision frame and returns their number. last_fired[p] is the
 /// last frame in which pixel p fired (-1: none yet); frame indices only grow, so comparing with
@@ -87,6 +109,7 @@ int PixelIndex(const EventStream& events, size_t i) {
 template <typename FrameOpened>
 int64_t WalkCollisionFrames(const EventStream& events, const WindowRange& range,
                             FrameOpened frame_opened) {
+  if (range.first == range.last) return 0;
   std::vector<int32_t> last_fired(static_cast<size_t>(events.width()) * events.height(), -1);
   int32_t current = -1;
   for (size_t i = range.first; i < range.last; ++i) {
@@ -219,7 +242,6 @@ EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_
   EventFrames frames(events.height(), events.width());
   std::vector<int64_t> latent_timestamps_ns;
   latent_timestamps_ns.reserve(static_cast<size_t>(num_steps) + 1);
-  const auto t_first_it = events.t_ns().begin();
   for (size_t k = 0; k < num_collision; ++k) {
     const int64_t frame_ns = boundaries_ns[k + 1] - boundaries_ns[k];
     size_t first = frame_first[k];
@@ -228,22 +250,11 @@ EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_
       const int64_t part_end_ns = boundaries_ns[k] + FloorFraction(frame_ns, j + 1, parts[k]);
       // The frame's own events only (a collision decides the frame, not the time), the last
       // part taking the rest.
-      const size_t last =
-          j + 1 == parts[k]
-              ? frame_first[k + 1]
-              : static_cast<size_t>(std::lower_bound(t_first_it + first,
-                                                     t_first_it + frame_first[k + 1], part_end_ns) -
-                                    t_first_it);
-      EventFrameSpan span;
-      span.latent_first = static_cast<int>(latent_timestamps_ns.size());
-      span.latent_last = span.latent_first + 1;
-      span.num_events = static_cast<int64_t>(last - first);
-      span.t_first_ns = span.num_events > 0 ? events.t_ns(first) : part_begin_ns;
-      span.t_last_ns = span.num_events > 0 ? events.t_ns(last - 1) : part_begin_ns;
-      float* values = frames.frame_data(frames.AddFrame(span));
-      for (size_t i = first; i < last; ++i) {
-        values[PixelIndex(events, i)] = static_cast<float>(events.polarity(i));
-      }
+      const size_t last = j + 1 == parts[k]
+                              ? frame_first[k + 1]
+                              : FirstAtOrAfter(events, first, frame_first[k + 1], part_end_ns);
+      const int latent = static_cast<int>(latent_timestamps_ns.size());
+      AppendEventFrame(events, first, last, latent, latent + 1, part_begin_ns, &frames);
       latent_timestamps_ns.push_back(part_begin_ns);
       first = last;
     }
@@ -307,25 +318,13 @@ EventFrames BinStacked(const EventStream& events, int64_t t_begin_ns, int64_t t_
   latent_timestamps_ns.push_back(t_end_ns);
 
   EventFrames frames(events.height(), events.width());
-  const auto t_begin_it = events.t_ns().begin();
   size_t frame_first = range.first;
   for (int m = 0; m < num_frames; ++m) {
     const size_t frame_last =
-        m + 1 == num_frames
-            ? range.last
-            : static_cast<size_t>(std::lower_bound(t_begin_it + frame_first,
-                                                   t_begin_it + range.last, boundaries_ns[m + 1]) -
-                                  t_begin_it);
-    EventFrameSpan span;
-    span.latent_first = m * steps;
-    span.latent_last = (m + 1) * steps;
-    span.num_events = static_cast<int64_t>(frame_last - frame_first);
-    span.t_first_ns = span.num_events > 0 ? events.t_ns(frame_first) : boundaries_ns[m];
-    span.t_last_ns = span.num_events > 0 ? events.t_ns(frame_last - 1) : boundaries_ns[m];
-    float* values = frames.frame_data(frames.AddFrame(span));
-    for (size_t i = frame_first; i < frame_last; ++i) {
-      values[PixelIndex(events, i)] += static_cast<float>(events.polarity(i));
-    }
+        m + 1 == num_frames ? range.last
+                            : FirstAtOrAfter(events, frame_first, range.last, boundaries_ns[m + 1]);
+    AppendEventFrame(events, frame_first, frame_last, m * steps, (m + 1) * steps, boundaries_ns[m],
+                     &frames);
     frame_first = frame_last;
   }
   frames.set_latent_timestamps_ns(std::move(latent_timestamps_ns));
