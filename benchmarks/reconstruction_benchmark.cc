@@ -6,6 +6,10 @@
 //
 //   reconstruction_benchmark --data=../shared/data [--cases=slider,shapes,cups,clips]
 //                            [--clips=nfs_basketball_7,adobe240_GOPR9637b,...] [--csv=FILE]
+//                            [--solver=METHOD [--contrast_threshold=C]]
+//
+// --solver runs another method of `evfs reconstruct --solver` on the same cases (a case it does
+// not support is skipped, with a line on stderr); the table's evfs column is then that method.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -15,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +63,11 @@ DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once; <= 0: no limit.");
 DEFINE_string(init, "blend", "blend | events: where the solve starts.");
+DEFINE_string(solver, evfs::MethodName(evfs::MethodOptions().method),
+              "the method (as evfs reconstruct --solver); the published figures use ceres_lm.");
+DEFINE_double(contrast_threshold, evfs::BaselineOptions().contrast_threshold,
+              "integrate, cf, edi and the events start (--init=events): the change one event "
+              "stands for; 0 derives it (edi: its sharpness search).");
 DEFINE_bool(whole_objective, false,
             "after each clip solve, print to stderr the objective of its answer evaluated as one "
             "problem (no memory budget), to compare a banded solve with the whole one");
@@ -118,6 +128,23 @@ BinningOptions Binning() {
   return binning;
 }
 
+MethodOptions MethodFromFlags() {
+  MethodOptions method;
+  method.method = ParseMethod(FLAGS_solver);
+  method.reconstruction = Options();
+  method.baseline.contrast_threshold = FLAGS_contrast_threshold;
+  method.initialization = ParseInitialization(FLAGS_init);
+  return method;
+}
+
+// Whether --solver runs on `scene`; if not, says so on stderr.
+bool Supported(const std::string& name, const char* kind, const Scene& scene) {
+  std::string why_not;
+  if (MethodSupports(MethodFromFlags().method, scene, &why_not)) return true;
+  std::fprintf(stderr, "%s %s: skipped, %s\n", name.c_str(), kind, why_not.c_str());
+  return false;
+}
+
 // PSNR rows compare by difference, other rows (sharpness) by ratio; rows without a baseline
 // (baseline_name "-") by neither.
 void PrintRow(const Row& row) {
@@ -147,9 +174,8 @@ Row RunTruthCase(const std::string& snippet, Mode mode, int first, int last, int
   request.first = first;
   request.last = last;
   request.truth = truth;
-  request.method.reconstruction = Options();
+  request.method = MethodFromFlags();
   request.binning = Binning();
-  request.method.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   Row row{snippet,
@@ -170,9 +196,8 @@ std::vector<Row> RunCupsDeblur(int frame) {
   request.data_path = (fs::path(FLAGS_data) / "eslnet_cups_blur").string();
   request.mode = Mode::kDeblur;
   request.first = frame;
-  request.method.reconstruction = Options();
+  request.method = MethodFromFlags();
   request.binning = Binning();
-  request.method.initialization = ParseInitialization(FLAGS_init);
   const auto start = Clock::now();
   const ReconstructResult result = RunReconstruction(request);
   const double wall_s = SecondsSince(start);
@@ -262,28 +287,45 @@ void PrintWholeObjective(const std::string& name, const char* kind, const Scene&
                static_cast<long long>(result.summary.problem.batches));
 }
 
+// A clip case's answer by --solver. ceres_lm is solved here (from the --init start, within the
+// memory budget, its whole objective printed on request), another method as `evfs reconstruct`
+// runs it. The sharp frames are met after an iterative solve, as `evfs reconstruct` finishes
+// (app/method.h ApplySharpFrameSeams).
+Video SolveClip(const std::string& name, const char* kind, const Scene& scene) {
+  const MethodOptions method = MethodFromFlags();
+  if (method.method != Method::kCeresLm) {
+    MethodResult run = RunMethod(scene, method);
+    ApplySharpFrameSeams(scene, method, &run);
+    return std::move(run.video);
+  }
+  std::string initial_method;
+  const Video initial =
+      InitialLatentVideo(scene, method.initialization, method.baseline, &initial_method);
+  Reconstruction result = Reconstruct(scene, method.reconstruction, &initial);
+  PrintWholeObjective(name, kind, scene, result);
+  if (method.reconstruction.meet_sharp_frames && result.summary.solved) {
+    MeetSharpFrames(scene, &result.video);
+  }
+  return std::move(result.video);
+}
+
 // The interpolation row and, after it, the two crossing-interpolation oracle rows (which
-// solve nothing).
+// solve nothing); none when --solver does not interpolate.
 std::vector<Row> RunClipInterpolation(const std::string& name, const SimulatedClip& clip) {
   const auto start = Clock::now();
   const Scene scene = MakeClipInterpolationScene(clip, Binning());
-  std::string initial_method;
-  const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
-                                           BaselineOptions(), &initial_method);
-  Reconstruction result = Reconstruct(scene, Options(), &initial);
-  PrintWholeObjective(name, "interpolate", scene, result);
-  // As `evfs reconstruct` finishes (app/method.h ApplySharpFrameSeams).
-  if (Options().meet_sharp_frames && result.summary.solved) MeetSharpFrames(scene, &result.video);
-  const int index = result.video.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame));
+  if (!Supported(name, "interpolate", scene)) return {};
+  const Video video = SolveClip(name, "interpolate", scene);
+  const int index = video.NearestFrame(clip.frames.timestamp_ns(kClipTruthFrame));
   const Image& truth = clip.frames.frame(kClipTruthFrame);
   const double blend_psnr = Psnr(InitializeLatentVideo(scene).frame(index), truth);
   const Row interpolation{name,
                           "interpolate",
                           "PSNR dB (frame 2 from 0, 4)",
                           blend_psnr,
-                          Psnr(result.video.frame(index), truth),
+                          Psnr(video.frame(index), truth),
                           "blend",
-                          result.video.num_frames(),
+                          video.num_frames(),
                           SecondsSince(start)};
   const Row nominal{name,
                     "interpolate",
@@ -336,25 +378,23 @@ double BrightnessOnlyOracle(const SimulatedClip& clip, const Image& blurred) {
   });
 }
 
-// The deblur row and, after it, the two brightness oracle rows (which solve nothing).
+// The deblur row and, after it, the two brightness oracle rows (which solve nothing); none when
+// --solver does not deblur.
 std::vector<Row> RunClipDeblur(const std::string& name, const SimulatedClip& clip) {
   const auto start = Clock::now();
   const Image blurred = ClipBlurredFrame(clip).image;
   const Scene scene = MakeClipDeblurScene(clip, Binning());
-  std::string initial_method;
-  const Video initial = InitialLatentVideo(scene, ParseInitialization(FLAGS_init),
-                                           BaselineOptions(), &initial_method);
-  const Reconstruction result = Reconstruct(scene, Options(), &initial);
-  PrintWholeObjective(name, "deblur", scene, result);
+  if (!Supported(name, "deblur", scene)) return {};
+  const Video video = SolveClip(name, "deblur", scene);
   const double blurred_psnr =
       MeanPsnrOverClip(clip, [&blurred](const Image&) -> const Image& { return blurred; });
   const Row deblur{name,
                    "deblur",
                    "PSNR dB (mean over frames 0-7)",
                    blurred_psnr,
-                   ScoreClipDeblur(result.video, clip, Psnr),
+                   ScoreClipDeblur(video, clip, Psnr),
                    "blurred",
-                   result.video.num_frames(),
+                   video.num_frames(),
                    SecondsSince(start)};
   const Row blind{name,
                   "deblur",
@@ -388,10 +428,27 @@ int Main() {
     PrintRow(row);
     rows.push_back(row);
   };
-  if (Wants("slider")) add(RunTruthCase("slider_depth_70_71", Mode::kPredict, 0, 1, 1));
-  if (Wants("shapes")) add(RunTruthCase("shapes_rotation_13_20", Mode::kInterpolate, 2, 4, 3));
+  // A DAVIS case --solver does not support is skipped with RunReconstruction's reason.
+  const auto davis_case = [](const char* name, const auto& run) {
+    try {
+      run();
+    } catch (const InvalidArgumentError& error) {
+      if (MethodFromFlags().method == Method::kCeresLm) throw;
+      std::fprintf(stderr, "%s: skipped, %s\n", name, error.what());
+    }
+  };
+  if (Wants("slider")) {
+    davis_case("slider_depth_70_71",
+               [&] { add(RunTruthCase("slider_depth_70_71", Mode::kPredict, 0, 1, 1)); });
+  }
+  if (Wants("shapes")) {
+    davis_case("shapes_rotation_13_20",
+               [&] { add(RunTruthCase("shapes_rotation_13_20", Mode::kInterpolate, 2, 4, 3)); });
+  }
   if (Wants("cups")) {
-    for (const Row& row : RunCupsDeblur(1)) add(row);
+    davis_case("eslnet_cups_blur", [&] {
+      for (const Row& row : RunCupsDeblur(1)) add(row);
+    });
   }
   if (Wants("clips")) {
     for (const std::string& name : SplitCommaList(FLAGS_clips)) {
