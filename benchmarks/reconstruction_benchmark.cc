@@ -19,7 +19,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,7 +30,6 @@
 #include "core/time.h"
 #include "events/simulator.h"
 #include "solver/reconstructor.h"
-#include "solver/sharp_frame_seams.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
 DEFINE_string(cases, "slider,shapes,cups,clips", "Comma-separated cases to run.");
@@ -62,7 +60,8 @@ DEFINE_double(step_ramp_px, evfs::ReconstructionOptions().step_ramp_px,
               "steps ramped over the time the scene takes to move this many pixels.");
 DEFINE_int64(max_problem_mb, evfs::ReconstructionOptions().max_problem_mb,
              "Most memory (MiB) the Ceres problems hold at once; <= 0: no limit.");
-DEFINE_string(init, "blend", "blend | events: where the solve starts.");
+DEFINE_string(init, evfs::InitializationName(evfs::MethodOptions().initialization),
+              "blend | events: where the solve starts.");
 DEFINE_string(solver, evfs::MethodName(evfs::MethodOptions().method),
               "the method (as evfs reconstruct --solver); the published figures use ceres_lm.");
 DEFINE_double(contrast_threshold, evfs::BaselineOptions().contrast_threshold,
@@ -272,41 +271,29 @@ double CrossingInterpolationOracle(const SimulatedClip& clip, bool own_threshold
   return Psnr(estimate, clip.frames.frame(kClipTruthFrame));
 }
 
-// --whole_objective: the objective at `result` of the whole problem (one problem, no memory
-// budget), on stderr. A solve in bands minimises overlapping problems whose own costs do not add
-// up to the whole's; this puts both on one scale.
+// --whole_objective: the objective at a ceres_lm answer of the whole problem (one problem, no
+// memory budget), on stderr. A solve in bands minimises overlapping problems whose own costs do
+// not add up to the whole's; this puts both on one scale.
 void PrintWholeObjective(const std::string& name, const char* kind, const Scene& scene,
-                         const Reconstruction& result) {
-  if (!FLAGS_whole_objective) return;
+                         const MethodResult& run) {
+  if (!FLAGS_whole_objective || run.method != MethodName(Method::kCeresLm)) return;
   ReconstructionOptions whole = Options();
   whole.max_problem_mb = 0;
   whole.solver.max_num_iterations = 1;
-  const Reconstruction at_answer = Reconstruct(scene, whole, &result.video);
+  const Reconstruction at_answer = Reconstruct(scene, whole, &run.video);
   std::fprintf(stderr, "%s %s: whole objective at the answer %.9g (solved as %lld batches)\n",
                name.c_str(), kind, at_answer.summary.initial_cost,
-               static_cast<long long>(result.summary.problem.batches));
+               static_cast<long long>(run.reconstruction.problem.batches));
 }
 
-// A clip case's answer by --solver. ceres_lm is solved here (from the --init start, within the
-// memory budget, its whole objective printed on request), another method as `evfs reconstruct`
-// runs it. The sharp frames are met after an iterative solve, as `evfs reconstruct` finishes
-// (app/method.h ApplySharpFrameSeams).
+// A clip case's answer by --solver, as `evfs reconstruct` gives it: the method from the --init
+// start, then the sharp frames met (app/method.h ApplySharpFrameSeams).
 Video SolveClip(const std::string& name, const char* kind, const Scene& scene) {
   const MethodOptions method = MethodFromFlags();
-  if (method.method != Method::kCeresLm) {
-    MethodResult run = RunMethod(scene, method);
-    ApplySharpFrameSeams(scene, method, &run);
-    return std::move(run.video);
-  }
-  std::string initial_method;
-  const Video initial =
-      InitialLatentVideo(scene, method.initialization, method.baseline, &initial_method);
-  Reconstruction result = Reconstruct(scene, method.reconstruction, &initial);
-  PrintWholeObjective(name, kind, scene, result);
-  if (method.reconstruction.meet_sharp_frames && result.summary.solved) {
-    MeetSharpFrames(scene, &result.video);
-  }
-  return std::move(result.video);
+  MethodResult run = RunMethod(scene, method);
+  PrintWholeObjective(name, kind, scene, run);
+  ApplySharpFrameSeams(scene, method, &run);
+  return std::move(run.video);
 }
 
 // The interpolation row and, after it, the two crossing-interpolation oracle rows (which
