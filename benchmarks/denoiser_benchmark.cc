@@ -4,6 +4,7 @@
 //                      [--runs=10] [--csv=FILE] [--out=PICTURE_DIR] [--cases=NAME,...]
 //                      [--clip_crop_px=N]
 //                      [--pnp_iterations=N --pnp_rho=R --pnp_rho_growth=G]
+//                      [--pnp=false] [--generic=false]
 //
 // speed: ms per 240×180 frame (median of --runs) with 5 %, 25 % and 100 % of the pixels active
 //   (a centred rectangle), for one network on OpenCV's own threads and for one network per
@@ -17,6 +18,8 @@
 //   denoisers with their strength tuned on the truth (OpenCV's fastNlMeansDenoising and its
 //   TV-L1 denoiser, run on the scored frames only), PSNR / SSIM and ms per frame. With --out, a
 //   picture per case (DMR | DMR + RD | truth, a zoomed crop below), as the paper's Fig. 7.
+//   --pnp=false and --generic=false leave out the slow rows (their cells read "-"), to compare
+//   weights files on the once row alone.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -60,6 +63,8 @@ DEFINE_bool(denoise_calibration, evfs::DenoiseRequest().calibrate,
             "DMR + RD once: scale the correction by what the case's frames support, as evfs "
             "does by default (the scale is printed after the case's name); false: as the "
             "network gives it.");
+DEFINE_bool(pnp, true, "Quality: run the plug & play row.");
+DEFINE_bool(generic, true, "Quality: run the truth-tuned fastNlMeans and TV-L1 rows.");
 DEFINE_int32(pnp_iterations, evfs::PlugAndPlayOptions().iterations,
              "Plug & play: ADMM iterations.");
 DEFINE_double(pnp_rho, evfs::PlugAndPlayOptions().initial_rho,
@@ -155,6 +160,14 @@ void RunSpeed() {
 }
 
 // ---- quality ----
+
+// printf into a string.
+template <typename... Args>
+std::string Format(const char* format, Args... args) {
+  char buffer[128];
+  std::snprintf(buffer, sizeof(buffer), format, args...);
+  return buffer;
+}
 
 struct Score {
   double first = 0.0, second = 0.0;  // PSNR and SSIM (cups: re-blur PSNR and sharpness ×1e3)
@@ -260,11 +273,13 @@ QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last
   if (with_rd.denoise.calibrated) c.rd_scale = with_rd.denoise.calibration.scale;
   c.rd = with_rd.run.video;
   c.rd_ms_per_frame = 1e3 * with_rd.denoise.stats.time_s / std::max(1, c.rd.num_frames());
-  request.denoise.mode = DenoiseMode::kPnp;
-  request.denoise.pnp = PnpFromFlags();
-  const ReconstructResult with_pnp = RunReconstruction(request);
-  c.pnp = with_pnp.run.video;
-  c.pnp_s = with_pnp.denoise.pnp.solve_time_s + with_pnp.denoise.pnp.denoise_time_s;
+  if (FLAGS_pnp) {
+    request.denoise.mode = DenoiseMode::kPnp;
+    request.denoise.pnp = PnpFromFlags();
+    const ReconstructResult with_pnp = RunReconstruction(request);
+    c.pnp = with_pnp.run.video;
+    c.pnp_s = with_pnp.denoise.pnp.solve_time_s + with_pnp.denoise.pnp.denoise_time_s;
+  }
   const auto source = DataSource::Open(request.data_path);
   if (truth >= 0) {
     c.metrics = "PSNR / SSIM (frame " + std::to_string(truth) + ")";
@@ -310,11 +325,13 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
                          FLAGS_denoise_calibration ? &scene : nullptr, nullptr, -1, &c.rd);
   if (once.calibrated) c.rd_scale = once.calibration.scale;
   c.rd_ms_per_frame = 1e3 * once.stats.time_s / std::max(1, c.rd.num_frames());
-  MethodResult pnp_run = run;
-  const DenoiseRecord pnp = PlugAndPlayLatentVideo(denoiser, scene, method, PnpFromFlags(), region,
-                                                   nullptr, -1, &pnp_run);
-  c.pnp = std::move(pnp_run.video);
-  c.pnp_s = pnp.pnp.solve_time_s + pnp.pnp.denoise_time_s;
+  if (FLAGS_pnp) {
+    MethodResult pnp_run = run;
+    const DenoiseRecord pnp = PlugAndPlayLatentVideo(denoiser, scene, method, PnpFromFlags(),
+                                                     region, nullptr, -1, &pnp_run);
+    c.pnp = std::move(pnp_run.video);
+    c.pnp_s = pnp.pnp.solve_time_s + pnp.pnp.denoise_time_s;
+  }
   if (deblur) {
     c.metrics = "PSNR / SSIM (mean over frames 0-7)";
     c.score = [frames = clip.frames](const Video& video) {
@@ -457,13 +474,21 @@ void RunQuality() {
   for (size_t i = 0; i < makers.size(); ++i) {
     if (!Wanted(names[i])) continue;
     const QualityCase c = makers[i]();
-    const Score dmr = c.score(c.dmr), rd = c.score(c.rd), pnp_score = c.score(c.pnp);
+    const Score dmr = c.score(c.dmr), rd = c.score(c.rd);
+    const Score pnp_score = FLAGS_pnp ? c.score(c.pnp) : Score{};
     char scale[32] = "";
     if (c.rd_scale >= 0.0) std::snprintf(scale, sizeof(scale), " (s %.2f)", c.rd_scale);
     const std::string name = c.name + scale;
+    const char* pair_format = c.has_truth ? "%.2f / %.4f" : "%.2f / %.2f";
+    const auto pair = [pair_format](const Score& score) {
+      return Format(pair_format, score.first, score.second);
+    };
+    std::string pnp_cells = "- | -";
+    if (FLAGS_pnp) pnp_cells = pair(pnp_score) + Format(" | %+.2f", pnp_score.first - dmr.first);
     double h = 0.0, lambda = 0.0, nlm_ms = 0.0, tv_ms = 0.0;
     Score nlm, tv;
-    if (c.has_truth) {
+    std::string generic_cells = "n/a | n/a", generic_ms = "-, -";
+    if (c.has_truth && FLAGS_generic) {
       nlm = TuneOnTruth(
           c, {1, 2, 3, 5, 7, 10, 15},
           [](const cv::Mat& in, cv::Mat& out, double strength) {
@@ -476,25 +501,20 @@ void RunQuality() {
             cv::denoise_TVL1({in}, out, strength, 30);
           },
           &lambda, &tv_ms);
-      once_gain.push_back(rd.first - dmr.first);
-      pnp_gain.push_back(pnp_score.first - dmr.first);
       nlm_gain.push_back(nlm.first - dmr.first);
-      std::printf(
-          "| %s | %s | %.2f / %.4f | %.2f / %.4f | %+.2f | %.2f / %.4f | %+.2f | %.2f / %.4f (%g) "
-          "| %.2f / %.4f (%g) | %.1f, %.1f, %.1f | %.1f |\n",
-          name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
-          rd.first - dmr.first, pnp_score.first, pnp_score.second, pnp_score.first - dmr.first,
-          nlm.first, nlm.second, h, tv.first, tv.second, lambda, c.rd_ms_per_frame, nlm_ms, tv_ms,
-          c.pnp_s);
-    } else {
-      // No truth to tune the generic denoisers on.
-      std::printf(
-          "| %s | %s | %.2f / %.2f | %.2f / %.2f | %+.2f | %.2f / %.2f | %+.2f | n/a | n/a | "
-          "%.1f, -, - | %.1f |\n",
-          name.c_str(), c.metrics.c_str(), dmr.first, dmr.second, rd.first, rd.second,
-          rd.first - dmr.first, pnp_score.first, pnp_score.second, pnp_score.first - dmr.first,
-          c.rd_ms_per_frame, c.pnp_s);
+      generic_cells = pair(nlm) + Format(" (%g) | ", h) + pair(tv) + Format(" (%g)", lambda);
+      generic_ms = Format("%.1f, %.1f", nlm_ms, tv_ms);
+    } else if (c.has_truth) {
+      generic_cells = "- | -";
     }
+    if (c.has_truth) {
+      once_gain.push_back(rd.first - dmr.first);
+      if (FLAGS_pnp) pnp_gain.push_back(pnp_score.first - dmr.first);
+    }
+    std::printf("| %s | %s | %s | %s | %+.2f | %s | %s | %.1f, %s | %s |\n", name.c_str(),
+                c.metrics.c_str(), pair(dmr).c_str(), pair(rd).c_str(), rd.first - dmr.first,
+                pnp_cells.c_str(), generic_cells.c_str(), c.rd_ms_per_frame, generic_ms.c_str(),
+                FLAGS_pnp ? Format("%.1f", c.pnp_s).c_str() : "-");
     if (csv) {
       csv << c.name << "," << c.metrics << "," << dmr.first << "," << dmr.second << "," << rd.first
           << "," << rd.second << "," << pnp_score.first << "," << pnp_score.second << ","

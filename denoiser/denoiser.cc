@@ -35,6 +35,12 @@ constexpr int kMaxThreads = 1024;
 constexpr int kProbeHeight = 19;
 constexpr int kProbeWidth = 26;
 
+// Where a network's output pixels look (DeriveGeometry).
+struct NetworkGeometry {
+  int radius_px;          // receptive radius in input pixels; -1: unknown
+  int input_multiple_px;  // input sides and tile offsets are kept multiples of this
+};
+
 // Layers that act on each pixel alone (no spatial extent): they add nothing to the receptive
 // field. OpenCV's names for what ONNX exports of DnCNN-style networks contain.
 const std::set<std::string>& PointwiseLayerTypes() {
@@ -114,15 +120,82 @@ cv::dnn::Net LoadNetwork(const std::string& bytes, const std::string& path) {
   return net;
 }
 
+// How far one output pixel of a convolution (or transposed convolution) layer reaches into its
+// input along one axis, in units of the finer of the two grids: the window [−pad, (k−1)·d − pad]
+// around the pixel's own position.
+int HalfExtent(const cv::dnn::BaseConvolutionLayer& conv, size_t axis) {
+  const int kernel = static_cast<int>(conv.kernel_size[axis]);
+  const int dilation = axis < conv.dilations.size() ? static_cast<int>(conv.dilations[axis]) : 1;
+  const int pad = axis < conv.pads_begin.size() ? static_cast<int>(conv.pads_begin[axis]) : 0;
+  const int span = (kernel - 1) * dilation;
+  return std::max(pad, span - pad);
+}
+
+// The receptive radius and the input multiple of a network made of convolutions (strided or
+// not), transposed convolutions and pointwise layers, taken in order as one chain: each layer's
+// reach, in input pixels at the resolution it works at, is summed (an upper bound when the graph
+// branches, as a skip connection does). `multiple` is the largest total stride: an input whose
+// sides and offsets are multiples of it keeps the same sampling grid. {-1, 1} when a layer of
+// another kind (pooling, resizing) or a stride the chain cannot undo makes the radius unknown.
+NetworkGeometry DeriveGeometry(cv::dnn::Net& net) {
+  const NetworkGeometry unknown{-1, 1};
+  NetworkGeometry geometry{0, 1};
+  int scale = 1;  // input pixels per pixel at the current layer's input
+  for (const std::string& name : net.getLayerNames()) {
+    const cv::Ptr<cv::dnn::Layer> layer = net.getLayer(name);
+    const auto* conv = dynamic_cast<const cv::dnn::BaseConvolutionLayer*>(layer.get());
+    if (conv == nullptr) {
+      if (PointwiseLayerTypes().count(layer->type) == 0) return unknown;
+      continue;
+    }
+    const bool transposed = layer->type == "Deconvolution";
+    int stride = 1, half_extent = 0;
+    for (size_t axis = 0; axis < conv->kernel_size.size(); ++axis) {
+      const int axis_stride =
+          axis < conv->strides.size() ? static_cast<int>(conv->strides[axis]) : 1;
+      if (axis > 0 && axis_stride != stride) return unknown;  // one stride for both axes
+      stride = axis_stride;
+      half_extent = std::max(half_extent, HalfExtent(*conv, axis));
+    }
+    if (stride < 1) return unknown;
+    if (transposed) {
+      if (scale % stride != 0) return unknown;
+      scale /= stride;
+      geometry.radius_px += half_extent * scale;
+    } else {
+      geometry.radius_px += half_extent * scale;
+      scale *= stride;
+      geometry.input_multiple_px = std::max(geometry.input_multiple_px, scale);
+    }
+  }
+  if (scale != 1) return unknown;
+  return geometry;
+}
+
+// `input` (1×1×h×w) padded at the bottom and right to multiples of `multiple` by repeating its
+// last row and column, as the trainer does (tools/train_denoiser/train.py, run_network).
+cv::Mat PadToMultiple(const cv::Mat& input, int multiple) {
+  const int height = input.size[2], width = input.size[3];
+  const int pad_bottom = (multiple - height % multiple) % multiple;
+  const int pad_right = (multiple - width % multiple) % multiple;
+  if (pad_bottom == 0 && pad_right == 0) return input;
+  const cv::Mat plane(height, width, CV_32F, const_cast<float*>(input.ptr<float>()));
+  const int shape[] = {1, 1, height + pad_bottom, width + pad_right};
+  cv::Mat padded(4, shape, CV_32F);
+  cv::Mat padded_plane(shape[2], shape[3], CV_32F, padded.ptr<float>());
+  cv::copyMakeBorder(plane, padded_plane, 0, pad_bottom, 0, pad_right, cv::BORDER_REPLICATE);
+  return padded;
+}
+
 // Runs `net` on `input` (1×1×h×w) and returns its output, which must have the same shape.
 cv::Mat Forward(cv::dnn::Net& net, const cv::Mat& input) {
   net.setInput(input, "input");
   return net.forward();
 }
 
-// Checks the contract of denoiser.h on a probe input: the input is named `input` and takes one
-// channel, and the output has the input's shape.
-void CheckShape(cv::dnn::Net& net, const std::string& path) {
+// Checks the contract of denoiser.h on a probe input (padded to multiples of `multiple`): the
+// input is named `input` and takes one channel, and the output has the input's shape.
+void CheckShape(cv::dnn::Net& net, int multiple, const std::string& path) {
   const std::vector<std::string> outputs = net.getUnconnectedOutLayersNames();
   if (outputs.size() != 1) {
     throw InputError(
@@ -132,6 +205,8 @@ void CheckShape(cv::dnn::Net& net, const std::string& path) {
   const int shape[] = {1, 1, kProbeHeight, kProbeWidth};
   cv::Mat probe(4, shape, CV_32F);
   cv::randu(probe, 0.0f, 1.0f);
+  probe = PadToMultiple(probe, multiple);
+  const int probe_height = probe.size[2], probe_width = probe.size[3];
   cv::Mat output;
   try {
     QuietOpenCvLog quiet;
@@ -140,39 +215,25 @@ void CheckShape(cv::dnn::Net& net, const std::string& path) {
     throw InputError(InputError::Kind::kMalformed, path, 0,
                      "expected a network mapping a 1x1xHxW input named 'input' to 1x1xHxW; "
                      "running it on 1x1x" +
-                         std::to_string(kProbeHeight) + "x" + std::to_string(kProbeWidth) +
+                         std::to_string(probe_height) + "x" + std::to_string(probe_width) +
                          " failed: " + ShortCvMessage(error));
   }
   if (output.dims != 4 || output.size[0] != 1 || output.size[1] != 1 ||
-      output.size[2] != kProbeHeight || output.size[3] != kProbeWidth || output.type() != CV_32F) {
+      output.size[2] != probe_height || output.size[3] != probe_width || output.type() != CV_32F) {
     throw InputError(InputError::Kind::kMalformed, path, 0,
                      "expected a network mapping 1x1xHxW to 1x1xHxW (float); it maps 1x1x" +
-                         std::to_string(kProbeHeight) + "x" + std::to_string(kProbeWidth) + " to " +
+                         std::to_string(probe_height) + "x" + std::to_string(probe_width) + " to " +
                          ShapeText(output.size));
   }
 }
 
-// The receptive radius of a chain of stride-1 convolutions and pointwise layers (the sum of
-// the convolutions' half-extents, an upper bound when the graph branches); -1 when a layer of
-// another kind (pooling, resizing, strided convolution) makes it unknown.
-int ReceptiveRadius(cv::dnn::Net& net) {
-  int radius = 0;
-  for (const std::string& name : net.getLayerNames()) {
-    const cv::Ptr<cv::dnn::Layer> layer = net.getLayer(name);
-    if (const auto* conv = dynamic_cast<const cv::dnn::BaseConvolutionLayer*>(layer.get())) {
-      int half_extent = 0;
-      for (size_t axis = 0; axis < conv->kernel_size.size(); ++axis) {
-        if (axis < conv->strides.size() && conv->strides[axis] != 1) return -1;
-        const size_t dilation = axis < conv->dilations.size() ? conv->dilations[axis] : 1;
-        half_extent =
-            std::max(half_extent, static_cast<int>((conv->kernel_size[axis] - 1) / 2 * dilation));
-      }
-      radius += half_extent;
-    } else if (PointwiseLayerTypes().count(layer->type) == 0) {
-      return -1;
-    }
-  }
-  return radius;
+// The residual of `input` (1×1×h×w) as an h×w plane: the network run on the input padded to
+// multiples of `multiple` (NetworkGeometry), its output cropped back.
+cv::Mat Residual(cv::dnn::Net& net, const cv::Mat& input, int multiple) {
+  const cv::Mat output = Forward(net, PadToMultiple(input, multiple));
+  const cv::Mat plane(output.size[2], output.size[3], CV_32F,
+                      const_cast<float*>(output.ptr<float>()));
+  return plane(cv::Rect(0, 0, input.size[3], input.size[2])).clone();
 }
 
 // One network run: the rectangle `core` of frame `frame`, with `context` (core plus margin,
@@ -222,8 +283,10 @@ Denoiser::Denoiser(const DenoiserOptions& options) : options_(options) {
 
   networks_ = std::make_unique<Networks>();
   cv::dnn::Net first = LoadNetwork(bytes, path);
-  CheckShape(first, path);
-  receptive_radius_px_ = ReceptiveRadius(first);
+  const NetworkGeometry geometry = DeriveGeometry(first);
+  receptive_radius_px_ = geometry.radius_px;
+  input_multiple_px_ = geometry.input_multiple_px;
+  CheckShape(first, input_multiple_px_, path);
   if (options.margin_px >= 0) {
     margin_px_ = options.margin_px;
   } else if (receptive_radius_px_ >= 0) {
@@ -264,8 +327,12 @@ Video Denoiser::Apply(const Video& video, const DenoiseRegion& region, DenoiseSt
   // Tiles holding a pixel to denoise, merged along each row of tiles into runs (fewer margins
   // and fewer network calls); the same for every frame.
   const int tile = options_.tile_size_px;
+  // A tile's context starts at a multiple of the network's input multiple, so that a strided
+  // network samples it on the whole frame's grid.
+  const int multiple = input_multiple_px_;
   const auto expand = [&](const cv::Rect& core) {
-    const int x0 = std::max(0, core.x - margin_px_), y0 = std::max(0, core.y - margin_px_);
+    const int x0 = std::max(0, core.x - margin_px_) / multiple * multiple;
+    const int y0 = std::max(0, core.y - margin_px_) / multiple * multiple;
     const int x1 = std::min(width, core.x + core.width + margin_px_);
     const int y1 = std::min(height, core.y + core.height + margin_px_);
     return cv::Rect(x0, y0, x1 - x0, y1 - y0);
@@ -340,13 +407,13 @@ Video Denoiser::Apply(const Video& video, const DenoiseRegion& region, DenoiseSt
     const int net_index = networks.Acquire();
     cv::Mat residual;
     try {
-      residual = Forward(networks.nets[net_index], input);
+      residual = Residual(networks.nets[net_index], input, multiple);
     } catch (...) {
       networks.Release(net_index);
       throw;
     }
     networks.Release(net_index);
-    const float* r = residual.ptr<float>();
+    const float* r = residual.ptr<float>();  // context.height × context.width, continuous
     double* out = output.frame_data(task.frame);
     for (int y = task.core.y; y < task.core.y + task.core.height; ++y) {
       for (int x = task.core.x; x < task.core.x + task.core.width; ++x) {

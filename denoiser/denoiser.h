@@ -9,6 +9,8 @@
 // Only what the solver changed is touched: a frame is cut into tiles, and a tile is run through
 // the network (with its receptive field as margin, so that the result equals running the whole
 // frame) only when it holds a pixel to denoise. Every other pixel comes back bit-identical.
+// Networks with strided layers (a half-resolution middle) run on inputs padded to a multiple of
+// their total stride by repeating the last row and column, as the trainer does.
 #ifndef EVFS_DENOISER_DENOISER_H_
 #define EVFS_DENOISER_DENOISER_H_
 
@@ -81,12 +83,17 @@ class Denoiser {
   /// The network's receptive radius derived from its layers; -1 when a layer's extent is
   /// unknown (then margin_px must be given).
   int receptive_radius_px() const { return receptive_radius_px_; }
+  /// The product of the network's strides (1 for a network at full resolution throughout):
+  /// inputs are padded at the bottom and right to multiples of it by repeating the last row and
+  /// column, and tiles start at multiples of it, so that tiles give the whole frame's values.
+  int input_multiple_px() const { return input_multiple_px_; }
 
  private:
   struct Networks;
   DenoiserOptions options_;
   std::string sha256_;
   int receptive_radius_px_ = -1;
+  int input_multiple_px_ = 1;
   int margin_px_ = 0;
   std::unique_ptr<Networks> networks_;
 };

@@ -133,6 +133,90 @@ TEST(DenoiserTest, MatchesTheHandComputedNetwork) {
   }
 }
 
+// two_scale.onnx of data/make_test_networks.py in double precision, on the frame padded at the
+// bottom and right to even sides by repeating its last row and column (the inference contract):
+//   coarse_c(i, j) = relu(b1_c + Σ_{dy,dx} W1[c](dy,dx) · P(2i+dy, 2j+dx)),  c = 0, 1
+//   R(y, x)        = P(y, x) + bu + Σ_c U[c](y mod 2, x mod 2) · coarse_c(y/2, x/2)
+// cropped back to the frame.
+using UpKernel = std::array<std::array<double, 2>, 2>;
+const std::array<UpKernel, 2> kUpKernels = {UpKernel{{{1.0 / 8, 2.0 / 8}, {3.0 / 8, 4.0 / 8}}},
+                                            UpKernel{{{-2.0 / 8, 1.0 / 8}, {0, -1.0 / 8}}}};
+const double kUpBias = 0.25;
+
+Image HandTwoScaleResidual(const Image& frame) {
+  const int rows = frame.rows() + frame.rows() % 2, cols = frame.cols() + frame.cols() % 2;
+  Image padded(rows, cols);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      padded(y, x) = frame(std::min<int>(y, frame.rows() - 1), std::min<int>(x, frame.cols() - 1));
+    }
+  }
+  Image residual = padded + kUpBias;
+  for (int c = 0; c < 2; ++c) {
+    const Image fine = (Correlate(padded, kFirstKernels[c]) + kFirstBias[c]).max(0.0);
+    for (int y = 0; y < rows; ++y) {
+      for (int x = 0; x < cols; ++x) {
+        const double coarse = fine(y / 2 * 2, x / 2 * 2);  // stride 2: the even pixels
+        residual(y, x) += kUpKernels[c][y % 2][x % 2] * coarse;
+      }
+    }
+  }
+  return residual.topLeftCorner(frame.rows(), frame.cols());
+}
+
+DenoiserOptions TwoScaleOptions() {
+  DenoiserOptions options;
+  options.weights_path = DataPath("two_scale.onnx");
+  options.num_threads = 2;
+  return options;
+}
+
+// A network with a half-resolution middle (as the shipped one): its geometry is derived from
+// its layers, and frames of odd sides are padded as the contract says.
+TEST(DenoiserTest, TwoScaleNetworkMatchesTheHandComputation) {
+  const Denoiser denoiser(TwoScaleOptions());
+  EXPECT_EQ(denoiser.receptive_radius_px(), 2);
+  EXPECT_EQ(denoiser.input_multiple_px(), 2);
+  for (const auto& [height, width] : {std::pair{36, 52}, std::pair{37, 53}, std::pair{1, 1}}) {
+    const Video video = RandomVideo(height, width, 2, 5);
+    const Video denoised = denoiser.Apply(video);
+    for (int t = 0; t < 2; ++t) {
+      const Image expected = Image(video.frame(t)) - HandTwoScaleResidual(Image(video.frame(t)));
+      const double error = (Image(denoised.frame(t)) - expected).abs().maxCoeff();
+      EXPECT_LT(error, kFloatTolerance) << height << "x" << width << " frame " << t;
+    }
+  }
+}
+
+// Tiles of a strided network start on its sampling grid: with odd tile sizes and odd frame
+// sides they still give the whole frame's values.
+TEST(DenoiserTest, TwoScaleTilesMatchTheWholeFrame) {
+  const Video video = RandomVideo(71, 89, 2, 13);
+  const Video whole = Denoiser(TwoScaleOptions()).Apply(video);
+  DenoiseRegion region;
+  region.pixels.assign(video.pixels_per_frame(), 0);
+  for (int y = 60; y < 71; ++y) {
+    for (int x = 75; x < 89; ++x) region.pixels[y * 89 + x] = 1;  // the bottom-right corner
+  }
+  for (int y = 21; y < 34; ++y) {
+    for (int x = 13; x < 30; ++x) region.pixels[y * 89 + x] = 1;
+  }
+  for (const int tile : {8, 9, 11}) {
+    DenoiserOptions options = TwoScaleOptions();
+    options.tile_size_px = tile;
+    DenoiseStats stats;
+    const Video denoised = Denoiser(options).Apply(video, region, &stats);
+    EXPECT_GT(stats.tiles, 2) << "tile " << tile;
+    for (int t = 0; t < 2; ++t) {
+      for (int64_t p = 0; p < video.pixels_per_frame(); ++p) {
+        const double expected = region.pixels[p] ? whole.frame_data(t)[p] : video.frame_data(t)[p];
+        ASSERT_NEAR(denoised.frame_data(t)[p], expected, kTileTolerance)
+            << "tile " << tile << " frame " << t << " pixel " << p;
+      }
+    }
+  }
+}
+
 // A frame cut into tiles (context = receptive radius) gives the whole frame's values at the
 // selected pixels and leaves every other pixel bit-identical.
 TEST(DenoiserTest, TilesMatchTheWholeFrameAndSkippedPixelsAreUntouched) {
