@@ -72,12 +72,12 @@ def main(argv):
         subprocess.run([sys.executable, train_py, f"--pairs={pairs}", f"--onnx={onnx_path}",
                         f"--log={log}", f"--reference_dir={scratch}", "--steps=2",
                         "--held_out_every=2", "--validate_every=1", "--opencv_runs=1",
-                        "--depth=3", "--channels=4"], check=True)
+                        "--channels=4", "--coarse_channels=4", "--coarse_depth=1"], check=True)
         import onnx
         model = onnx.load(onnx_path)
         assert [i.name for i in model.graph.input] == ["input"]
         assert [o.name for o in model.graph.output] == ["output"]
-        assert {n.op_type for n in model.graph.node} <= {"Conv", "Relu"}
+        assert {n.op_type for n in model.graph.node} <= {"Conv", "Relu", "ConvTranspose", "Add"}
         with open(log) as f:
             text = f.read()
         assert "| 2 |" in text, "the log has no row for step 2"

@@ -2,13 +2,16 @@
 """Trains evfs's residual denoiser (paper §3.4, issue 17) and exports it to ONNX.
 
 Reads the pairs of tools/make_denoiser_pairs (pair_*.npy, float32 (3, H, W): DMR latent frame,
-ground truth, solver activity mask; pairs.tsv), trains a DnCNN-style network to predict the
-residual R(H) = H - H_true on 40x40 patches with random flips and rotations, keeps the
+ground truth, solver activity mask; pairs.tsv), trains a convolutional network (by default a
+two-scale one with a half-resolution middle; --arch=dncnn for the paper's DnCNN) to predict the
+residual R(H) = H - H_true on 48x48 patches with random flips and rotations, keeps the
 checkpoint with the best PSNR on held-out pairs (every tenth sample of the training sources,
 never the evfs validation recordings), and writes
 
   * the ONNX file (input `input`, output `output`, both 1x1xHxW float32, dynamic H and W,
-    opset 11): the residual, so that the denoised frame is H - R(H);
+    opset 11): the residual, so that the denoised frame is H - R(H). The two-scale network needs
+    even H and W: a frame is padded at the bottom and right by repeating its last row and column
+    (run_network), as the C++ inference module does;
   * reference_input.pfm / reference_output.pfm: a small input and torch's output for it, for
     the C++ equality test (PFM: OpenCV's cv::imread reads it as CV_32FC1);
   * a Markdown log with the data, schedule, timings and scores.
@@ -48,15 +51,23 @@ def parse_args(argv):
     parser.add_argument("--log", default="", help="Markdown log to write ('' for none)")
     parser.add_argument("--reference_dir", default="",
                         help="folder for reference_input.pfm / reference_output.pfm ('' for none)")
-    parser.add_argument("--depth", type=int, default=8, help="convolution layers, >= 2")
-    parser.add_argument("--channels", type=int, default=12, help="feature channels")
+    parser.add_argument("--arch", choices=["dncnn", "twoscale"], default="twoscale",
+                        help="dncnn: --depth layers of --channels at full resolution; twoscale: "
+                        "--channels at full resolution around --coarse_depth layers of "
+                        "--coarse_channels at half resolution")
+    parser.add_argument("--depth", type=int, default=8, help="dncnn: convolution layers, >= 2")
+    parser.add_argument("--channels", type=int, default=8, help="full-resolution channels")
+    parser.add_argument("--coarse_channels", type=int, default=24,
+                        help="twoscale: channels at half resolution")
+    parser.add_argument("--coarse_depth", type=int, default=5,
+                        help="twoscale: 3x3 layers at half resolution")
     parser.add_argument("--steps", type=int, default=12000, help="optimiser steps")
     parser.add_argument("--batch", type=int, default=64, help="patches per step")
-    parser.add_argument("--patch", type=int, default=40, help="patch side in pixels")
+    parser.add_argument("--patch", type=int, default=48, help="patch side in pixels")
     parser.add_argument("--lr", type=float, default=1e-3, help="initial Adam learning rate")
     parser.add_argument("--lr_drops", default="0.6,0.85",
                         help="fractions of --steps where the learning rate is divided by 10")
-    parser.add_argument("--validate_every", type=int, default=300,
+    parser.add_argument("--validate_every", type=int, default=600,
                         help="steps between evaluations on the held-out pairs")
     parser.add_argument("--held_out_every", type=int, default=10,
                         help="samples whose index is a multiple of this are held out")
@@ -64,6 +75,9 @@ def parse_args(argv):
                         help="db: mean change of each patch's error in dB; mse: pixel MSE")
     parser.add_argument("--min_active", type=float, default=0.05,
                         help="fewest fraction of active pixels a training patch needs")
+    parser.add_argument("--noise_free", action="store_true",
+                        help="train and validate only on the pairs simulated without background "
+                        "events and frame noise")
     parser.add_argument("--seed", type=int, default=17)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--opencv_runs", type=int, default=15,
@@ -87,11 +101,61 @@ class ResidualDenoiser(nn.Module):
     def forward(self, x):
         return self.body(x)
 
+    def last_layer(self):
+        return self.body[-1]
+
+    def description(self):
+        depth = sum(isinstance(m, nn.Conv2d) for m in self.body)
+        return f"DnCNN-style, depth {depth}, {self.body[0].out_channels} channels, 3x3"
+
+
+class TwoScaleDenoiser(nn.Module):
+    """A residual network with a half-resolution middle: conv 3x3 (1 -> c) + ReLU at full
+    resolution; conv 3x3 stride 2 (c -> C) + ReLU; `coarse_depth` x conv 3x3 (C -> C) + ReLU at
+    half resolution; transposed conv 2x2 stride 2 (C -> c) added to the full-resolution features;
+    ReLU, conv 3x3 (c -> c) + ReLU, conv 3x3 (c -> 1). The half-resolution layers cost a quarter
+    of full-resolution ones per channel pair, so for a DnCNN's time it has about three times the
+    parameters and twice the receptive field. Input height and width must be even (the
+    inference module pads them)."""
+
+    def __init__(self, channels, coarse_channels, coarse_depth):
+        super().__init__()
+        self.head = nn.Sequential(nn.Conv2d(1, channels, 3, padding=1), nn.ReLU())
+        coarse = [nn.Conv2d(channels, coarse_channels, 3, stride=2, padding=1), nn.ReLU()]
+        for _ in range(coarse_depth):
+            coarse += [nn.Conv2d(coarse_channels, coarse_channels, 3, padding=1), nn.ReLU()]
+        coarse.append(nn.ConvTranspose2d(coarse_channels, channels, 2, stride=2))
+        self.coarse = nn.Sequential(*coarse)
+        self.tail = nn.Sequential(nn.ReLU(), nn.Conv2d(channels, channels, 3, padding=1),
+                                  nn.ReLU(), nn.Conv2d(channels, 1, 3, padding=1))
+        self.sizes = (channels, coarse_channels, coarse_depth)
+
+    def forward(self, x):
+        features = self.head(x)
+        return self.tail(self.coarse(features) + features)
+
+    def last_layer(self):
+        return self.tail[-1]
+
+    def description(self):
+        c, cc, depth = self.sizes
+        return (f"two-scale residual network, {c} channels at full resolution, {depth} layers "
+                f"of {cc} channels at half resolution, 3x3")
+
+
+def make_model(args):
+    if args.arch == "dncnn":
+        return ResidualDenoiser(args.depth, args.channels)
+    return TwoScaleDenoiser(args.channels, args.coarse_channels, args.coarse_depth)
+
 
 def fused_copy(model):
     """The network in eval mode with every BatchNorm folded into its convolution: a graph of
-    Conv and Relu only, which OpenCV 4.6 imports."""
+    Conv and Relu only (and, for the two-scale network, ConvTranspose and Add), which OpenCV 4.6
+    imports."""
     model = model.eval()
+    if not isinstance(model, ResidualDenoiser):
+        return model
     layers, modules, i = [], list(model.body), 0
     while i < len(modules):
         if (isinstance(modules[i], nn.Conv2d) and i + 1 < len(modules)
@@ -175,6 +239,16 @@ def masked_loss(model, batch, kind):
     return after.sum() / active.sum(), float(change_db.mean())
 
 
+def run_network(model, frame):
+    """R(H) of one frame (H, W), as the inference module computes it: the frame padded at the
+    bottom and right by replicating its last row and column to an even size, then cropped."""
+    h, w = frame.shape
+    x = torch.from_numpy(np.ascontiguousarray(frame)[None, None])
+    if h % 2 or w % 2:
+        x = torch.nn.functional.pad(x, (0, w % 2, 0, h % 2), mode="replicate")
+    return model(x)[0, 0, :h, :w].numpy()
+
+
 def evaluate(model, pairs):
     """Mean PSNR over the held-out pairs of the DMR frame and of the denoised one (the pixels the
     solver skipped kept, as the inference module does)."""
@@ -183,7 +257,7 @@ def evaluate(model, pairs):
     with torch.no_grad():
         for data in pairs:
             dmr, truth, mask = data[0], data[1], data[2]
-            residual = model(torch.from_numpy(dmr[None, None]))[0, 0].numpy()
+            residual = run_network(model, dmr)
             denoised = np.where(mask > 0, dmr - residual, dmr)
             before.append(psnr(dmr, truth))
             after.append(psnr(denoised, truth))
@@ -254,7 +328,7 @@ def opencv_check(path, fused, reference, runs):
     net.setInput(reference[None, None])
     opencv_out = net.forward()[0, 0]
     with torch.no_grad():
-        torch_out = fused(torch.from_numpy(reference[None, None]))[0, 0].numpy()
+        torch_out = run_network(fused, reference)
     frame = np.random.default_rng(0).random((1, 1, 180, 240), dtype=np.float32)
     times = []
     for _ in range(runs):
@@ -277,6 +351,10 @@ def main(argv):
     started = time.time()
 
     pairs = load_pairs(args.pairs)
+    if args.noise_free:
+        pairs = [(r, d) for r, d in pairs
+                 if " noise_hz=0 " in f" {r['configuration']} "
+                 and " frame_noise=0 " in f" {r['configuration']} "]
     held_out = [d for r, d in pairs if int(r["sample"]) % args.held_out_every == 0]
     training = [d for r, d in pairs if int(r["sample"]) % args.held_out_every != 0]
     if not held_out or not training:
@@ -291,11 +369,11 @@ def main(argv):
     print(f"train.py: {len(training)} training and {len(held_out)} held-out pairs; "
           f"sources {sources}; cases {cases}", flush=True)
 
-    model = ResidualDenoiser(args.depth, args.channels)
+    model = make_model(args)
     # Start as the identity: the last layer's weights near zero, so the first steps do not
     # make the DMR worse (the residual is small).
-    nn.init.normal_(model.body[-1].weight, std=1e-3)
-    nn.init.zeros_(model.body[-1].bias)
+    nn.init.normal_(model.last_layer().weight, std=1e-3)
+    nn.init.zeros_(model.last_layer().bias)
     parameters = sum(p.numel() for p in model.parameters())
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr, betas=(0.9, 0.999))
     drops = [int(float(f) * args.steps) for f in args.lr_drops.split(",") if f]
@@ -347,7 +425,7 @@ def main(argv):
     chosen = max(candidates, key=lambda d: d[2, :crop_h, :crop_w].sum())
     reference = np.ascontiguousarray(chosen[0, :crop_h, :crop_w])
     with torch.no_grad():
-        reference_out = fused(torch.from_numpy(reference[None, None]))[0, 0].numpy()
+        reference_out = run_network(fused, reference)
     if args.reference_dir:
         os.makedirs(args.reference_dir, exist_ok=True)
         write_pfm(os.path.join(args.reference_dir, "reference_input.pfm"), reference)
@@ -361,7 +439,7 @@ def main(argv):
                  f"{opencv['max_abs_diff_vs_torch']:.2e} (> 1e-4)")
 
     summary = {
-        "architecture": f"DnCNN-style, depth {args.depth}, {args.channels} channels, 3x3",
+        "architecture": model.description(),
         "parameters": parameters, "onnx_ops": ops, "onnx_bytes": len(onnx_bytes),
         "sha256": sha256, "pairs_training": len(training), "pairs_held_out": len(held_out),
         "sources": sources, "cases": cases, "loss": args.loss, "steps": args.steps,

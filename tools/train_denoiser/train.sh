@@ -16,7 +16,7 @@ build_dir=${1:?usage: train.sh BUILD_DIR [WORK_DIR]}
 work_dir=${2:-$build_dir/denoiser_training}
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 samples=${SAMPLES:-400}
-steps=${STEPS:-3000}
+steps=${STEPS:-12000}
 seed=${SEED:-17}
 
 opencv_data=/usr/share/doc/opencv-doc/examples/data
