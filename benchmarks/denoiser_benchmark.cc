@@ -51,6 +51,8 @@ DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
 DEFINE_string(parts, "speed,quality", "speed, quality or both.");
 DEFINE_int32(runs, 10, "Runs per speed measurement (the median is reported).");
 DEFINE_int32(threads, 2, "Threads of the one-network-per-thread rows.");
+DEFINE_int32(tile_size_px, evfs::DenoiserOptions().tile_size_px,
+             "Speed: the side of the tiles a frame is cut into (DenoiserOptions).");
 DEFINE_string(csv, "", "Also write the quality rows as CSV to this file.");
 DEFINE_string(out, "",
               "Write a picture per quality case (DMR | DMR + RD | truth, a zoomed crop below) "
@@ -130,14 +132,17 @@ DenoiseRegion CentredRegion(double fraction) {
 
 void RunSpeed() {
   const Video video = SpeedVideo();
-  std::printf("\n## Denoiser speed: %s, %dx%d frames, median of %d runs of %d frames\n\n",
-              WeightsPath().c_str(), kSpeedWidth, kSpeedHeight, FLAGS_runs, kSpeedFrames);
+  std::printf(
+      "\n## Denoiser speed: %s, %dx%d frames, tiles of %d px, median of %d runs of %d frames\n\n",
+      WeightsPath().c_str(), kSpeedWidth, kSpeedHeight, FLAGS_tile_size_px, FLAGS_runs,
+      kSpeedFrames);
   std::printf("| active area | threads | networks | ms per frame | network pixels per frame |\n");
   std::printf("| --- | --- | --- | --- | --- |\n");
   for (const int networks : {1, FLAGS_threads}) {
     DenoiserOptions options;
     options.weights_path = WeightsPath();
     options.num_threads = networks;
+    options.tile_size_px = FLAGS_tile_size_px;
     const Denoiser denoiser(options);
     // One network: OpenCV parallelises each convolution over the threads itself. Several: each
     // network runs on one thread, frames and tiles side by side.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
@@ -324,8 +325,9 @@ Video Denoiser::Apply(const Video& video, const DenoiseRegion& region, DenoiseSt
     return region.pixels.empty() || region.pixels[p] != 0;
   };
 
-  // Tiles holding a pixel to denoise, merged along each row of tiles into runs (fewer margins
-  // and fewer network calls); the same for every frame.
+  // Tiles holding a pixel to denoise, merged along each row of tiles into runs, and a run
+  // continued down the next rows of tiles while they hold a run of the same columns (fewer
+  // margins and fewer network calls); the same for every frame.
   const int tile = options_.tile_size_px;
   // A tile's context starts at a multiple of the network's input multiple, so that a strided
   // network samples it on the whole frame's grid.
@@ -339,9 +341,22 @@ Video Denoiser::Apply(const Video& video, const DenoiseRegion& region, DenoiseSt
   };
   std::vector<cv::Rect> cores;
   int64_t selected_pixels = 0;
+  std::map<std::pair<int, int>, size_t> above;  // (x, width) of the previous row's runs → core
   for (int y0 = 0; y0 < height; y0 += tile) {
     const int rows = std::min(tile, height - y0);
     const int columns = (width + tile - 1) / tile;
+    std::map<std::pair<int, int>, size_t> here;
+    const auto add_run = [&](int x, int run_width) {
+      const std::pair<int, int> key(x, run_width);
+      const auto it = above.find(key);
+      if (it != above.end()) {
+        cores[it->second].height += rows;
+        here[key] = it->second;
+      } else {
+        here[key] = cores.size();
+        cores.emplace_back(x, y0, run_width, rows);
+      }
+    };
     int run_begin = -1;
     for (int column = 0; column <= columns; ++column) {  // the last pass closes an open run
       const int x0 = column * tile;
@@ -359,10 +374,11 @@ Video Denoiser::Apply(const Video& video, const DenoiseRegion& region, DenoiseSt
       }
       if (any && run_begin < 0) run_begin = x0;
       if (!any && run_begin >= 0) {
-        cores.emplace_back(run_begin, y0, std::min(x0, width) - run_begin, rows);
+        add_run(run_begin, std::min(x0, width) - run_begin);
         run_begin = -1;
       }
     }
+    above = std::move(here);
   }
   for (int64_t p = 0; p < video.pixels_per_frame(); ++p) selected_pixels += pixel_selected(p);
   int64_t tiles_cost = 0;

@@ -217,6 +217,31 @@ TEST(DenoiserTest, TwoScaleTilesMatchTheWholeFrame) {
   }
 }
 
+// A block of active pixels spanning several rows of tiles is run as one rectangle (one network
+// call per frame, one margin around it), not as a run per row of tiles.
+TEST(DenoiserTest, ABlockOfTilesIsOneNetworkRun) {
+  const Video video = RandomVideo(70, 90, 2, 17);
+  DenoiserOptions options = TwoConvOptions();
+  options.tile_size_px = 8;
+  DenoiseRegion region;
+  region.pixels.assign(video.pixels_per_frame(), 0);
+  for (int y = 17; y < 39; ++y) {
+    for (int x = 25; x < 44; ++x) region.pixels[y * 90 + x] = 1;  // tiles 2-4 × 3-5
+  }
+  DenoiseStats stats;
+  const Video denoised = Denoiser(options).Apply(video, region, &stats);
+  EXPECT_EQ(stats.tiles, 2);
+  // Tiles of columns 24-48 and rows 16-40, with the 2-pixel margin.
+  EXPECT_EQ(stats.network_pixels, 2 * (24 + 4) * (24 + 4));
+  const Video whole = Denoiser(TwoConvOptions()).Apply(video);
+  for (int t = 0; t < 2; ++t) {
+    for (int64_t p = 0; p < video.pixels_per_frame(); ++p) {
+      const double expected = region.pixels[p] ? whole.frame_data(t)[p] : video.frame_data(t)[p];
+      ASSERT_NEAR(denoised.frame_data(t)[p], expected, kTileTolerance) << "pixel " << p;
+    }
+  }
+}
+
 // A frame cut into tiles (context = receptive radius) gives the whole frame's values at the
 // selected pixels and leaves every other pixel bit-identical.
 TEST(DenoiserTest, TilesMatchTheWholeFrameAndSkippedPixelsAreUntouched) {
