@@ -481,9 +481,7 @@ void RunQuality() {
     const QualityCase c = makers[i]();
     const Score dmr = c.score(c.dmr), rd = c.score(c.rd);
     const Score pnp_score = FLAGS_pnp ? c.score(c.pnp) : Score{};
-    char scale[32] = "";
-    if (c.rd_scale >= 0.0) std::snprintf(scale, sizeof(scale), " (s %.2f)", c.rd_scale);
-    const std::string name = c.name + scale;
+    const std::string name = c.name + (c.rd_scale >= 0.0 ? Format(" (s %.2f)", c.rd_scale) : "");
     const char* pair_format = c.has_truth ? "%.2f / %.4f" : "%.2f / %.2f";
     const auto pair = [pair_format](const Score& score) {
       return Format(pair_format, score.first, score.second);

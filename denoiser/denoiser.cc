@@ -229,7 +229,9 @@ void CheckShape(cv::dnn::Net& net, int multiple, const std::string& path) {
 }
 
 // The residual of `input` (1×1×h×w) as an h×w plane: the network run on the input padded to
-// multiples of `multiple` (NetworkGeometry), its output cropped back.
+// multiples of `multiple` (NetworkGeometry), its output cropped back. A copy, continuous and
+// owned: the network's output buffer is overwritten by its next run, which another thread may
+// start as soon as the network is released.
 cv::Mat Residual(cv::dnn::Net& net, const cv::Mat& input, int multiple) {
   const cv::Mat output = Forward(net, PadToMultiple(input, multiple));
   const cv::Mat plane(output.size[2], output.size[3], CV_32F,
