@@ -130,9 +130,8 @@ DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
   }
   Video denoised = denoiser.Apply(*latent, region, &record.stats);
   if (observed != nullptr) {
-    record.calibrated = true;
-    record.calibration = CalibrateResidual(*observed, *latent, denoised);
-    ScaleResidual(record.calibration.scale, *latent, &denoised);
+    record.consistent = true;
+    record.consistency = KeepFramesConsistent(*observed, *latent, &denoised);
   }
   *latent = std::move(denoised);
   return record;
@@ -196,13 +195,13 @@ Json DenoiseJson(const DenoiseRecord& record) {
                    {"denoise_time_s", record.pnp.denoise_time_s}};
   }
   if (record.mode == DenoiseMode::kOnce) {
-    if (record.calibrated) {
-      json["calibration"] = {{"residual_scale", record.calibration.scale},
-                             {"agreement", record.calibration.agreement},
-                             {"energy", record.calibration.energy},
-                             {"observations", record.calibration.observations}};
+    if (record.consistent) {
+      json["consistency"] = {{"observations", record.consistency.observations},
+                             {"correction_energy", record.consistency.correction_energy},
+                             {"removed_energy", record.consistency.removed_energy},
+                             {"removed_fraction", record.consistency.RemovedFraction()}};
     } else {
-      json["calibration"] = nullptr;
+      json["consistency"] = nullptr;
     }
   }
   if (record.scored) {

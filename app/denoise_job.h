@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/frame_consistency.h"
 #include "app/method.h"
 #include "app/plug_and_play.h"
-#include "app/residual_calibration.h"
 #include "core/enum_names.h"
 #include "core/video.h"
 #include "denoiser/denoiser.h"
@@ -34,9 +34,9 @@ inline constexpr EnumName<DenoiseMode> kDenoiseModeNames[] = {
 std::string ShippedDenoiserWeights();
 
 /// What `--denoise=auto` does with the shipped weights: the mode that measured best against the
-/// reconstruction alone on the validation cases (BENCHMARKS.md, "Residual denoiser"); none
-/// while no mode gains over DMR on the mean with the weights shipped.
-inline constexpr DenoiseMode kShippedWeightsDenoiseMode = DenoiseMode::kNone;
+/// reconstruction alone on the validation cases (BENCHMARKS.md, "Residual denoiser"): once, with
+/// the correction kept consistent with the frames.
+inline constexpr DenoiseMode kShippedWeightsDenoiseMode = DenoiseMode::kOnce;
 
 /// `--denoise=auto`: once when the user names weights (`weights_path` not empty: they asked for
 /// a denoiser), kShippedWeightsDenoiseMode when weights are shipped, else none.
@@ -48,8 +48,8 @@ struct DenoiseRequest {
   DenoiserOptions denoiser;
   /// Mode pnp: the ADMM iterations and ρ schedule.
   PlugAndPlayOptions pnp;
-  /// Mode once: scale the correction by what the scene's frames support (CalibrateResidual).
-  bool calibrate = true;
+  /// Mode once: keep the correction consistent with the scene's frames (KeepFramesConsistent).
+  bool consistency = true;
 };
 
 /// What denoising did, for summary.json.
@@ -64,9 +64,9 @@ struct DenoiseRecord {
   double psnr_before = 0.0, ssim_before = 0.0;
   /// Mode pnp: the ADMM iterations (stats then sums every application of the denoiser).
   PlugAndPlayRecord pnp;
-  /// Mode once with a scene to calibrate against: the residual's scale.
-  bool calibrated = false;
-  ResidualCalibration calibration;
+  /// Mode once with a scene to keep consistent with: what the projection took out.
+  bool consistent = false;
+  FrameConsistency consistency;
 };
 
 /// The denoiser `request` asks for, loaded (null for mode none). Throws InvalidArgumentError

@@ -112,7 +112,7 @@ ProgramHelp MakeEvfsHelp() {
       {"in", "denoiser", "denoise"},
       {"denoise", "denoiser", "reconstruct video"},
       {"denoiser", "denoiser", "reconstruct denoise video"},
-      {"denoise_calibration", "denoiser", "reconstruct video"},
+      {"denoise_consistency", "denoiser", "reconstruct video"},
       // evfs video's own.
       {"jobs", "solver", "video"},
       {"resume", "output", "video"},

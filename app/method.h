@@ -119,11 +119,11 @@ MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
                        const IterationCallback& progress = nullptr, bool record_checkpoints = false,
                        const CheckpointTruth* truth = nullptr);
 
-/// The last stage of a reconstruction, after the solve and any denoiser (whose calibration
-/// reads how far the solve left the frames): with options.reconstruction.meet_sharp_frames and
-/// an iterative method that solved, every sharp frame's latent frame takes the frame's values
-/// and its offset fades out around it (MeetSharpFrames, solver/sharp_frame_seams.h);
-/// result->seams records it.
+/// The last stage of a reconstruction, after the solve and any denoiser (which keeps the
+/// frames as the solve left them, KeepFramesConsistent): with
+/// options.reconstruction.meet_sharp_frames and an iterative method that solved, every sharp
+/// frame's latent frame takes the frame's values and its offset fades out around it
+/// (MeetSharpFrames, solver/sharp_frame_seams.h); result->seams records it.
 void ApplySharpFrameSeams(const Scene& scene, const MethodOptions& options, MethodResult* result);
 
 }  // namespace evfs

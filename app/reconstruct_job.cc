@@ -252,7 +252,7 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
                                               region, truth, truth_latent, &result.run);
     } else {
       result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region,
-                                          request.denoise.calibrate ? &scene : nullptr, truth,
+                                          request.denoise.consistency ? &scene : nullptr, truth,
                                           truth_latent, &result.run.video);
     }
   }

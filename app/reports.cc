@@ -1,5 +1,8 @@
 #include "app/reports.h"
 
+#include <cstdio>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "app/frame_lag.h"
@@ -105,6 +108,40 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
                EstimateRecordingFrameLag(source, indices, FrameLagOptions()).description.c_str());
 }
 
+namespace {
+
+// The denoiser's line: its mode, weights, work and time; what frame consistency took out; the
+// truth score before it. Nothing for mode none.
+void PrintDenoise(const DenoiseRecord& record, std::FILE* out) {
+  if (record.mode == DenoiseMode::kNone) return;
+  std::string line = std::string("denoise: ") + NameOf(kDenoiseModeNames, record.mode) + " (" +
+                     std::filesystem::path(record.weights_path).filename().string() + ", sha256 " +
+                     record.weights_sha256.substr(0, 12) + "…)";
+  char buffer[160];
+  if (record.mode == DenoiseMode::kPnp) {
+    std::snprintf(buffer, sizeof(buffer), ", %d ADMM iterations, solve %.2f s + denoise %.2f s",
+                  record.pnp.iterations, record.pnp.solve_time_s, record.pnp.denoise_time_s);
+  } else {
+    std::snprintf(buffer, sizeof(buffer), ", %d frames in %.2f s", record.stats.frames,
+                  record.stats.time_s);
+  }
+  line += buffer;
+  if (record.consistent) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "; %.0f %% of its correction taken out to keep the frames",
+                  100.0 * record.consistency.RemovedFraction());
+    line += buffer;
+  }
+  if (record.scored) {
+    std::snprintf(buffer, sizeof(buffer), "; before it: %.2f dB, %.4f", record.psnr_before,
+                  record.ssim_before);
+    line += buffer;
+  }
+  std::fprintf(out, "%s\n", line.c_str());
+}
+
+}  // namespace
+
 void PrintReconstruction(const ReconstructRequest& request, const ReconstructResult& result,
                          const std::string& out_path, std::FILE* out) {
   const MethodResult& run = result.run;
@@ -139,6 +176,7 @@ void PrintReconstruction(const ReconstructRequest& request, const ReconstructRes
     std::fprintf(out, "method: %s%s%s\n", run.method.c_str(),
                  run.threshold_source.empty() ? "" : ", ", run.threshold_source.c_str());
   }
+  PrintDenoise(result.denoise, out);
   if (result.has_truth) {
     std::fprintf(out, "truth: frame %d vs latent %d: PSNR %.2f dB, SSIM %.4f (%s: %.2f dB, %.4f)\n",
                  result.truth.index, result.truth.latent_index, result.truth.psnr,

@@ -208,7 +208,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
     denoise_record = DenoiseLatentVideo(
         *context.denoiser, request.denoise.mode, SolvedRegion(scene, context.method, run.solved),
-        request.denoise.calibrate ? &scene : nullptr, nullptr, -1, &run.video);
+        request.denoise.consistency ? &scene : nullptr, nullptr, -1, &run.video);
     denoise_s = SecondsSince(denoise_start);
   }
   ApplySharpFrameSeams(scene, context.method, &run);
@@ -258,9 +258,10 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["iterations"] = run.iterations;
   record["initial_cost"] = Number(run.initial_cost);
   record["final_cost"] = Number(run.final_cost);
-  // With --denoise=once: the scale of the denoiser's correction this window's frames supported.
-  if (denoise_record.calibrated) {
-    record["residual_scale"] = Number(denoise_record.calibration.scale);
+  // With --denoise=once: the fraction of the denoiser's correction this window's frames had
+  // observed (taken out to keep them as the solve left them).
+  if (denoise_record.consistent) {
+    record["consistency_removed"] = Number(denoise_record.consistency.RemovedFraction());
   }
   if (!window.truth_frames.empty()) {
     const Video blend = InitializeLatentVideo(scene);

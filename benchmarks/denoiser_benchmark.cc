@@ -61,10 +61,10 @@ DEFINE_int32(clip_crop_px, 0,
              "Keep the central N x N pixels of the adobe240 clips (0: whole 500x500 frames).");
 DEFINE_string(cases, "",
               "Only the quality cases whose name contains one of these (comma list); empty: all.");
-DEFINE_bool(denoise_calibration, evfs::DenoiseRequest().calibrate,
-            "DMR + RD once: scale the correction by what the case's frames support, as evfs "
-            "does by default (the scale is printed after the case's name); false: as the "
-            "network gives it.");
+DEFINE_bool(denoise_consistency, evfs::DenoiseRequest().consistency,
+            "DMR + RD once: keep the case's frames as the solve matched them, as evfs does by "
+            "default (the share of the correction's energy this took out is printed after the "
+            "case's name); false: the correction as the network gives it.");
 DEFINE_bool(pnp, true, "Quality: run the plug & play row.");
 DEFINE_bool(generic, true, "Quality: run the truth-tuned fastNlMeans and TV-L1 rows.");
 DEFINE_int32(pnp_iterations, evfs::PlugAndPlayOptions().iterations,
@@ -186,12 +186,17 @@ struct QualityCase {
   bool has_truth = true;
   Video dmr, rd, pnp;
   double rd_ms_per_frame = 0.0;
-  double rd_scale = -1.0;  // the calibrated residual scale; < 0: not calibrated
-  double pnp_s = 0.0;      // the ADMM iterations: x-updates and denoising
+  double rd_removed = -1.0;  // the share of the correction frame consistency took out; < 0: off
+  double pnp_s = 0.0;        // the ADMM iterations: x-updates and denoising
   // The latent frames the score reads: the truth-tuned generic denoisers filter only these
   // (the score does not see the others). Empty: every frame.
   std::vector<int> scored_frames;
   std::function<Score(const Video&)> score;
+  // Deblur cases with a truth: the truth's sharpness and a video's at the same frames (variance
+  // of the Laplacian, mean over the scored frames), to read cups' sharpness against. Empty
+  // elsewhere.
+  double truth_sharpness = 0.0;
+  std::function<double(const Video&)> sharpness;
   // The picture: latent frame `picture_frame` next to `reference` (the truth, or the blurred
   // input when there is none), labelled `reference_label`.
   int picture_frame = 0;
@@ -273,9 +278,9 @@ QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last
   c.dmr = RunReconstruction(request).run.video;
   request.denoise.denoiser.weights_path = WeightsPath();
   request.denoise.mode = DenoiseMode::kOnce;
-  request.denoise.calibrate = FLAGS_denoise_calibration;
+  request.denoise.consistency = FLAGS_denoise_consistency;
   const ReconstructResult with_rd = RunReconstruction(request);
-  if (with_rd.denoise.calibrated) c.rd_scale = with_rd.denoise.calibration.scale;
+  if (with_rd.denoise.consistent) c.rd_removed = with_rd.denoise.consistency.RemovedFraction();
   c.rd = with_rd.run.video;
   c.rd_ms_per_frame = 1e3 * with_rd.denoise.stats.time_s / std::max(1, c.rd.num_frames());
   if (FLAGS_pnp) {
@@ -327,8 +332,8 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
   c.rd = run.video;
   const DenoiseRecord once =
       DenoiseLatentVideo(denoiser, DenoiseMode::kOnce, region,
-                         FLAGS_denoise_calibration ? &scene : nullptr, nullptr, -1, &c.rd);
-  if (once.calibrated) c.rd_scale = once.calibration.scale;
+                         FLAGS_denoise_consistency ? &scene : nullptr, nullptr, -1, &c.rd);
+  if (once.consistent) c.rd_removed = once.consistency.RemovedFraction();
   c.rd_ms_per_frame = 1e3 * once.stats.time_s / std::max(1, c.rd.num_frames());
   if (FLAGS_pnp) {
     MethodResult pnp_run = run;
@@ -351,6 +356,17 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
     std::sort(c.scored_frames.begin(), c.scored_frames.end());
     c.scored_frames.erase(std::unique(c.scored_frames.begin(), c.scored_frames.end()),
                           c.scored_frames.end());
+    for (int t = 0; t < kClipFrames; ++t) {
+      c.truth_sharpness += LaplacianVariance(clip.frames.frame(t)) / kClipFrames;
+    }
+    c.sharpness = [frames = clip.frames](const Video& video) {
+      double sharpness = 0.0;
+      for (int t = 0; t < kClipFrames; ++t) {
+        sharpness += LaplacianVariance(video.frame(video.NearestFrame(frames.timestamp_ns(t)))) /
+                     kClipFrames;
+      }
+      return sharpness;
+    };
     c.picture_frame = c.dmr.NearestFrame(clip.frames.timestamp_ns(kClipFrames / 2));
     c.reference = clip.frames.frame(kClipFrames / 2);
   } else {
@@ -416,8 +432,9 @@ void WritePicture(const QualityCase& c, const std::string& folder) {
   }
   std::string file = c.name;
   std::replace(file.begin(), file.end(), ' ', '_');
-  const fs::path path = fs::path(folder) / (file + ".png");
-  if (!cv::imwrite(path.string(), canvas)) {
+  // JPEG at quality 92, small enough to commit beside BENCHMARKS.md.
+  const fs::path path = fs::path(folder) / (file + ".jpg");
+  if (!cv::imwrite(path.string(), canvas, {cv::IMWRITE_JPEG_QUALITY, 92})) {
     throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "cannot write the picture");
   }
 }
@@ -476,12 +493,15 @@ void RunQuality() {
 
   // Gains over DMR on the cases with a truth.
   std::vector<double> once_gain, pnp_gain, nlm_gain;
+  std::vector<std::string> sharpness_lines;
   for (size_t i = 0; i < makers.size(); ++i) {
     if (!Wanted(names[i])) continue;
     const QualityCase c = makers[i]();
     const Score dmr = c.score(c.dmr), rd = c.score(c.rd);
     const Score pnp_score = FLAGS_pnp ? c.score(c.pnp) : Score{};
-    const std::string name = c.name + (c.rd_scale >= 0.0 ? Format(" (s %.2f)", c.rd_scale) : "");
+    const std::string name =
+        c.name +
+        (c.rd_removed >= 0.0 ? Format(" (%.0f %% kept)", 100.0 * (1.0 - c.rd_removed)) : "");
     const char* pair_format = c.has_truth ? "%.2f / %.4f" : "%.2f / %.2f";
     const auto pair = [pair_format](const Score& score) {
       return Format(pair_format, score.first, score.second);
@@ -525,6 +545,11 @@ void RunQuality() {
           << "," << lambda << "," << c.rd_ms_per_frame << "," << nlm_ms << "," << tv_ms << ","
           << c.pnp_s << "\n";
     }
+    if (c.sharpness) {
+      sharpness_lines.push_back(Format("* %s: truth %.2f, DMR %.2f, DMR + RD once %.2f",
+                                       c.name.c_str(), 1e3 * c.truth_sharpness,
+                                       1e3 * c.sharpness(c.dmr), 1e3 * c.sharpness(c.rd)));
+    }
     if (!FLAGS_out.empty()) WritePicture(c, FLAGS_out);
     std::fflush(stdout);
   }
@@ -539,6 +564,12 @@ void RunQuality() {
   summary("DMR + RD once", once_gain);
   summary("DMR + RD pnp", pnp_gain);
   summary("DMR + fastNlMeans (tuned on the truth)", nlm_gain);
+  if (!sharpness_lines.empty()) {
+    std::printf(
+        "\nSharpness of the deblurred frames (variance of the Laplacian x1e3, mean over "
+        "the scored frames; cups reads its own against the DMR's):\n\n");
+    for (const std::string& line : sharpness_lines) std::printf("%s\n", line.c_str());
+  }
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 // run is the evfs binary in a process of its own (benchmarks/cell_runner.h), so its peak
 // resident memory is its own. Prints a table and writes video_benchmark.csv into --work_dir.
 //
-//   video_benchmark --work_dir=/tmp/vid_bench [--repeats=3]
+//   video_benchmark --work_dir=/tmp/vid_bench [--repeats=3] [--denoise=none|auto]
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -34,6 +34,9 @@ DEFINE_string(evfs, EVFS_BINARY, "The evfs binary.");
 DEFINE_int32(repeats, 3, "Runs per row; the table gives medians.");
 DEFINE_int32(width, 64, "Sensor width of the synthetic recordings.");
 DEFINE_int32(height, 48, "Sensor height of the synthetic recordings.");
+DEFINE_string(denoise, "none",
+              "evfs video's --denoise: none (the solve alone), auto (evfs' default: the shipped "
+              "denoiser, once) or once.");
 
 namespace evfs {
 namespace {
@@ -123,7 +126,7 @@ Row Measure(const Recording& recording, const std::string& name, int jobs, const
                                            "--overwrite",
                                            "--fps=" + std::to_string(static_cast<int>(kRenderHz)),
                                            "--jobs=" + std::to_string(jobs),
-                                           "--denoise=none",
+                                           "--denoise=" + FLAGS_denoise,
                                            "--progress_interval_s=0"};
     const CellRun run = RunCellProcess(args, (out / "summary.json").string(), CellLimits());
     CHECK(run.has_result) << name << ": " << run.failure;

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Whole clips, "skip 3" (issue 18; README "`evfs video`", BENCHMARKS.md "Whole clips"): events
 # simulated with `evfs simulate`'s defaults, every 4th frame observed, every withheld frame
-# scored, by `evfs video` with the default method and with event integration.
+# scored, by `evfs video` with the default method and denoiser, with the denoiser off
+# (`--denoise=none`: the model-based reconstruction alone) and with event integration.
 #
 #   benchmarks/whole_clips.sh [BUILD_DIR] [SCRATCH_DIR] [DATA_DIR] [CLIP...]
 #
-# Prints one row per clip: PSNR mean (worst) and SSIM mean of evfs, of the blend and of event
-# integration (`--solver=integrate`) over the withheld frames, and the wall time of evfs.
+# Prints one row per clip: PSNR mean (worst) and SSIM mean of evfs, of evfs without the denoiser,
+# of the blend and of event integration (`--solver=integrate`) over the withheld frames, and the
+# wall times of evfs with and without the denoiser.
 set -euo pipefail
 build=${1:-build}
 scratch=${2:-/tmp/evfs-whole-clips}
@@ -23,25 +25,35 @@ mkdir -p "$scratch"
 row() {
   /usr/bin/python3 - "$@" <<'PY'
 import json, sys
-clip, wall, evfs, integration = sys.argv[1:]
+clip, wall, wall_dmr, evfs, dmr, integration = sys.argv[1:]
 e = json.load(open(evfs))["truth"]
+d = json.load(open(dmr))["truth"]
 i = json.load(open(integration))["truth"]
-print("| %s | %d | %.2f (%.2f) | %.2f | %.2f | %.4f | %.4f | %.4f | %.0f s |" % (
-    clip, e["frames"], e["mean_psnr"], e["worst_psnr"], e["blend_mean_psnr"], i["mean_psnr"],
-    e["mean_ssim"], e["blend_mean_ssim"], i["mean_ssim"], float(wall)))
+print("| %s | %d | %.2f (%.2f) | %.2f (%.2f) | %.2f | %.2f | %.4f | %.4f | %.4f | %.4f | %.0f s, %.0f s |"
+      % (clip, e["frames"], e["mean_psnr"], e["worst_psnr"], d["mean_psnr"], d["worst_psnr"],
+         e["blend_mean_psnr"], i["mean_psnr"], e["mean_ssim"], d["mean_ssim"],
+         e["blend_mean_ssim"], i["mean_ssim"], float(wall), float(wall_dmr)))
 PY
 }
 
-echo "| clip | withheld frames | evfs PSNR mean (worst) | blend | integration | evfs SSIM | blend SSIM | integration SSIM | evfs wall |"
-echo "|---|---|---|---|---|---|---|---|---|"
+echo "| clip | withheld frames | evfs PSNR mean (worst) | without denoiser | blend | integration | evfs SSIM | without denoiser | blend SSIM | integration SSIM | evfs wall, without denoiser |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+
+# Runs evfs video on SIM into OUT with the flags after them; prints its wall time in seconds.
+timed_video() {
+  local sim=$1 out=$2
+  shift 2
+  local start
+  start=$(date +%s.%N)
+  "$evfs" video --data="$sim" --out="$out" --overwrite --frame_step=4 --fps=240 "$@" >/dev/null 2>&1
+  awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }'
+}
 for clip in "${clips[@]}"; do
   sim="$scratch/sim_$clip"
   [ -d "$sim" ] || "$evfs" simulate --frames="$data/$clip" --out="$sim" >/dev/null
-  start=$(date +%s.%N)
-  "$evfs" video --data="$sim" --out="$scratch/out_$clip" --overwrite --frame_step=4 --fps=240 \
-    >/dev/null 2>&1
-  wall=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
-  "$evfs" video --data="$sim" --out="$scratch/integrate_$clip" --overwrite --frame_step=4 \
-    --fps=240 --solver=integrate >/dev/null 2>&1
-  row "$clip" "$wall" "$scratch/out_$clip/summary.json" "$scratch/integrate_$clip/summary.json"
+  wall=$(timed_video "$sim" "$scratch/out_$clip")
+  wall_dmr=$(timed_video "$sim" "$scratch/dmr_$clip" --denoise=none)
+  timed_video "$sim" "$scratch/integrate_$clip" --solver=integrate >/dev/null
+  row "$clip" "$wall" "$wall_dmr" "$scratch/out_$clip/summary.json" \
+    "$scratch/dmr_$clip/summary.json" "$scratch/integrate_$clip/summary.json"
 done

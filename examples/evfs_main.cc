@@ -224,14 +224,15 @@ DEFINE_string(denoise, "auto",
               "reconstruct: none | once (the residual denoiser after the solve) | pnp (plug & "
               "play: ADMM between the Ceres problem and the denoiser, ceres_lm only) | auto "
               "(once when --denoiser is given; with the shipped weights the mode that measured "
-              "best, BENCHMARKS.md: none while no mode beats the solve alone).");
+              "best, BENCHMARKS.md: once).");
 DEFINE_string(denoiser, "",
               "The denoiser's ONNX weights (reconstruct, denoise); empty: the shipped "
               "models/evfs_denoiser.onnx.");
-DEFINE_bool(denoise_calibration, evfs::DenoiseRequest().calibrate,
-            "--denoise=once: scale the denoiser's correction by how well it explains the "
-            "recording's own frames (0 where it contradicts them, 1 where it agrees; README "
-            "\"Residual denoiser\"); false applies the network's correction as it is.");
+DEFINE_bool(denoise_consistency, evfs::DenoiseRequest().consistency,
+            "--denoise=once: keep the recording's own frames as the solve matched them (the "
+            "part of the denoiser's correction that would change a frame's exposure mean is "
+            "taken out; README \"Residual denoiser\"); false applies the network's correction "
+            "as it is.");
 DEFINE_string(in, "", "denoise: the reconstruction folder (written by evfs reconstruct).");
 DEFINE_double(progress_interval_s, 5.0,
               "While a command runs, a line on stderr (stage, "
@@ -438,7 +439,7 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   solver.num_threads = FLAGS_threads;
 
   request.denoise.denoiser.weights_path = FLAGS_denoiser;
-  request.denoise.calibrate = FLAGS_denoise_calibration;
+  request.denoise.consistency = FLAGS_denoise_consistency;
   if (FLAGS_denoise == "auto") {
     request.denoise.mode = AutoDenoiseMode(FLAGS_denoiser);
   } else {

@@ -266,8 +266,10 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
        [](py::handle v, R* s) {
          s->request.denoise.denoiser.weights_path = ToString("denoiser", v);
        }},
-      {"denoise_calibration", [](const R& s) { return py::cast(s.request.denoise.calibrate); },
-       [](py::handle v, R* s) { s->request.denoise.calibrate = ToBool("denoise_calibration", v); }},
+      {"denoise_consistency", [](const R& s) { return py::cast(s.request.denoise.consistency); },
+       [](py::handle v, R* s) {
+         s->request.denoise.consistency = ToBool("denoise_consistency", v);
+       }},
   };
   return table;
 }

@@ -57,10 +57,10 @@ TEST(EvfsDenoise, ReconstructOnceChangesOnlySolvedPixelsAndRecordsTheWeights) {
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string weights = NetworkPath("two_conv.onnx");
   const std::string plain = Reconstruct(data, scratch + "/plain", "--denoise=none");
-  // The network's correction as it is (the calibration is tested below).
+  // The network's correction as it is (frame consistency is tested below).
   const std::string denoised =
       Reconstruct(data, scratch + "/denoised",
-                  "--denoise=once --denoise_calibration=false --denoiser=" + weights);
+                  "--denoise=once --denoise_consistency=false --denoiser=" + weights);
 
   const nlohmann::json none = ReadSummary(plain);
   EXPECT_EQ(none["denoiser"]["mode"], "none");
@@ -90,58 +90,77 @@ TEST(EvfsDenoise, ReconstructOnceChangesOnlySolvedPixelsAndRecordsTheWeights) {
   EXPECT_EQ(record["pixels_changed"].get<int64_t>(), active * frames);
 }
 
-TEST(EvfsDenoise, OnceScalesTheCorrectionByTheCalibrationItRecords) {
-  const std::string scratch = ScratchDir("denoise_calibrated");
+TEST(EvfsDenoise, ReconstructSaysWhatTheDenoiserDid) {
+  const std::string scratch = ScratchDir("denoise_line");
+  const std::string data = WriteSyntheticFolder(scratch);
+  const std::string common =
+      "reconstruct --data=" + data +
+      " --mode=interpolate --first=0 --last=2 --truth=1 --denoiser=" + NetworkPath("two_conv.onnx");
+  const CommandResult once = RunEvfs(common + " --out=" + scratch + "/once");
+  ASSERT_EQ(once.exit_code, 0) << once.output;
+  EXPECT_NE(once.output.find("denoise: once (two_conv.onnx, sha256 "), std::string::npos)
+      << once.output;
+  EXPECT_NE(once.output.find("of its correction taken out to keep the frames; before it: "),
+            std::string::npos)
+      << once.output;
+  const CommandResult none = RunEvfs(common + " --denoise=none --out=" + scratch + "/none");
+  ASSERT_EQ(none.exit_code, 0) << none.output;
+  EXPECT_EQ(none.output.find("denoise:"), std::string::npos) << none.output;
+}
+
+TEST(EvfsDenoise, OnceKeepsTheSharpFramesAndRecordsWhatItTookOut) {
+  const std::string scratch = ScratchDir("denoise_consistent");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string weights = NetworkPath("two_conv.onnx");
   const std::string plain = Reconstruct(data, scratch + "/plain", "--denoise=none");
   const std::string full = Reconstruct(
-      data, scratch + "/full", "--denoise=once --denoise_calibration=false --denoiser=" + weights);
-  const std::string calibrated =
-      Reconstruct(data, scratch + "/calibrated", "--denoise=once --denoiser=" + weights);
+      data, scratch + "/full", "--denoise=once --denoise_consistency=false --denoiser=" + weights);
+  const std::string consistent =
+      Reconstruct(data, scratch + "/consistent", "--denoise=once --denoiser=" + weights);
 
-  EXPECT_TRUE(ReadSummary(full)["denoiser"]["calibration"].is_null());
-  const nlohmann::json calibration = ReadSummary(calibrated)["denoiser"]["calibration"];
-  ASSERT_TRUE(calibration.is_object()) << calibration;
-  const double scale = calibration["residual_scale"].get<double>();
-  EXPECT_GE(scale, 0.0);
-  EXPECT_LE(scale, 1.0);
-  EXPECT_EQ(calibration["observations"].get<int>(), 2);  // the two sharp frames
-  EXPECT_GT(calibration["energy"].get<double>(), 0.0);
-  // Every frame is the reconstruction minus `scale` times the full correction, to the 16-bit
-  // PNG's step.
+  EXPECT_TRUE(ReadSummary(full)["denoiser"]["consistency"].is_null());
+  const nlohmann::json consistency = ReadSummary(consistent)["denoiser"]["consistency"];
+  ASSERT_TRUE(consistency.is_object()) << consistency;
+  EXPECT_EQ(consistency["observations"].get<int>(), 2);  // the two sharp frames
+  EXPECT_GT(consistency["correction_energy"].get<double>(), 0.0);
+  const double removed = consistency["removed_fraction"].get<double>();
+  EXPECT_GT(removed, 0.0);
+  EXPECT_LT(removed, 1.0);
+  // The sharp frames' latent frames (the first and the last) keep the solve's values; every
+  // frame between them takes the network's correction as it is. To the 16-bit PNG's step.
   const int frames = CountFrames(plain);
-  ASSERT_EQ(CountFrames(calibrated), frames);
+  ASSERT_EQ(CountFrames(consistent), frames);
   for (int t = 0; t < frames; ++t) {
-    const Image before = Frame(plain, t);
-    const Image expected = before - scale * (before - Frame(full, t));
-    EXPECT_LE((Frame(calibrated, t) - expected).abs().maxCoeff(), 1.5 / 65535.0) << "frame " << t;
+    const bool sharp = t == 0 || t == frames - 1;
+    const Image expected = Frame(sharp ? plain : full, t);
+    EXPECT_LE((Frame(consistent, t) - expected).abs().maxCoeff(), 1.5 / 65535.0) << "frame " << t;
   }
+  EXPECT_GT((Frame(full, 0) - Frame(plain, 0)).abs().maxCoeff(), 1e-3);
 }
 
-TEST(EvfsDenoise, VideoWindowsRecordTheScaleTheirFramesSupported) {
+TEST(EvfsDenoise, VideoWindowsRecordWhatConsistencyTookOut) {
   const std::string scratch = ScratchDir("denoise_video");
   const std::string data = WriteSyntheticFolder(scratch);
   const std::string common = "video --data=" + data + " --fps=1000 --denoise=once --denoiser=" +
                              NetworkPath("two_conv.onnx");
-  const CommandResult calibrated = RunEvfs(common + " --out=" + scratch + "/calibrated");
-  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.output;
+  const CommandResult consistent = RunEvfs(common + " --out=" + scratch + "/consistent");
+  ASSERT_EQ(consistent.exit_code, 0) << consistent.output;
   const CommandResult full =
-      RunEvfs(common + " --denoise_calibration=false --out=" + scratch + "/full");
+      RunEvfs(common + " --denoise_consistency=false --out=" + scratch + "/full");
   ASSERT_EQ(full.exit_code, 0) << full.output;
   int solved = 0;
-  const nlohmann::json with = ReadSummary(scratch + "/calibrated");
+  const nlohmann::json with = ReadSummary(scratch + "/consistent");
   for (const nlohmann::json& window : with["windows"]) {
     if (!window["solved"].get<bool>()) continue;
     ++solved;
-    ASSERT_TRUE(window.contains("residual_scale")) << window;
-    EXPECT_GE(window["residual_scale"].get<double>(), 0.0);
-    EXPECT_LE(window["residual_scale"].get<double>(), 1.0);
+    ASSERT_TRUE(window.contains("consistency_removed")) << window;
+    EXPECT_GE(window["consistency_removed"].get<double>(), 0.0);
+    EXPECT_LE(window["consistency_removed"].get<double>(), 1.0);
   }
   EXPECT_GT(solved, 0);
   const nlohmann::json without = ReadSummary(scratch + "/full");
   for (const nlohmann::json& window : without["windows"]) {
-    EXPECT_FALSE(window.contains("residual_scale")) << window;
+    EXPECT_FALSE(window.contains("consistency_removed")) << window;
   }
 }
 

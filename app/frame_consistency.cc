@@ -1,0 +1,58 @@
+#include "app/frame_consistency.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+
+namespace evfs {
+namespace {
+
+double CorrectionEnergy(const Video& before, const Video& denoised) {
+  double energy = 0.0;
+  for (int t = 0; t < before.num_frames(); ++t) {
+    energy += (before.frame(t) - denoised.frame(t)).square().sum();
+  }
+  return energy;
+}
+
+}  // namespace
+
+FrameConsistency KeepFramesConsistent(const Scene& scene, const Video& before, Video* denoised) {
+  if (before.num_frames() != scene.num_latent_frames() ||
+      denoised->num_frames() != before.num_frames() || before.height() != scene.height ||
+      before.width() != scene.width || denoised->height() != before.height() ||
+      denoised->width() != before.width()) {
+    throw InvalidArgumentError(
+        "the videos to keep consistent are not on the scene's latent "
+        "timeline");
+  }
+  FrameConsistency consistency;
+  consistency.observations = static_cast<int>(scene.frames.size());
+  consistency.correction_energy = CorrectionEnergy(before, *denoised);
+  if (consistency.correction_energy == 0.0) return consistency;
+  // One pass projects onto each exposure in turn; exposures that share no latent frame are
+  // orthogonal, so the first pass is the projection and the second finds nothing left. Shared
+  // latent frames need more passes (alternating projections onto the frames' constraints
+  // converge to the projection onto all of them).
+  constexpr int kMaxPasses = 1000;
+  constexpr double kTolerance = 1e-12;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    double largest = 0.0;
+    for (const FrameObservation& frame : scene.frames) {
+      const int length = frame.latent_last - frame.latent_first + 1;
+      Image mean = Image::Zero(scene.height, scene.width);
+      for (int t = frame.latent_first; t <= frame.latent_last; ++t) {
+        mean += (before.frame(t) - denoised->frame(t)) / length;
+      }
+      largest = std::max(largest, mean.abs().maxCoeff());
+      // Where the denoiser changed nothing the mean is 0 and the pixel keeps its bits.
+      for (int t = frame.latent_first; t <= frame.latent_last; ++t) denoised->frame(t) += mean;
+    }
+    if (largest <= kTolerance) break;
+  }
+  consistency.removed_energy =
+      std::max(0.0, consistency.correction_energy - CorrectionEnergy(before, *denoised));
+  return consistency;
+}
+
+}  // namespace evfs
