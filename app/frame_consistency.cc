@@ -1,6 +1,7 @@
 #include "app/frame_consistency.h"
 
 #include <algorithm>
+#include <string>
 
 #include "core/error.h"
 
@@ -53,6 +54,39 @@ FrameConsistency KeepFramesConsistent(const Scene& scene, const Video& before, V
   consistency.removed_energy =
       std::max(0.0, consistency.correction_energy - CorrectionEnergy(before, *denoised));
   return consistency;
+}
+
+std::vector<uint8_t> FramesToDenoise(const Scene& scene, std::vector<uint8_t> read) {
+  const int n = scene.num_latent_frames();
+  if (static_cast<int>(read.size()) != n) {
+    throw InvalidArgumentError("frames to denoise: " + std::to_string(read.size()) + " flags for " +
+                               std::to_string(n) + " latent frames");
+  }
+  for (uint8_t& flag : read) flag = flag != 0 ? 1 : 0;
+  // How many exposures hold each latent frame.
+  std::vector<int> holders(n, 0);
+  for (const FrameObservation& frame : scene.frames) {
+    for (int t = frame.latent_first; t <= frame.latent_last; ++t) ++holders[t];
+  }
+  // Grow the flags over whole exposures until none grows (exposures sharing latent frames
+  // chain).
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const FrameObservation& frame : scene.frames) {
+      if (frame.latent_first == frame.latent_last) continue;
+      const auto first = read.begin() + frame.latent_first;
+      const auto last = read.begin() + frame.latent_last + 1;
+      if (std::find(first, last, 1) == last || std::count(first, last, 1) == last - first) continue;
+      std::fill(first, last, 1);
+      grew = true;
+    }
+  }
+  for (const FrameObservation& frame : scene.frames) {
+    if (frame.latent_first == frame.latent_last && holders[frame.latent_first] == 1) {
+      read[frame.latent_first] = 0;
+    }
+  }
+  return read;
 }
 
 }  // namespace evfs

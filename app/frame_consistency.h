@@ -16,6 +16,9 @@
 #ifndef EVFS_APP_FRAME_CONSISTENCY_H_
 #define EVFS_APP_FRAME_CONSISTENCY_H_
 
+#include <cstdint>
+#include <vector>
+
 #include "core/video.h"
 #include "scene/scene.h"
 
@@ -36,6 +39,15 @@ struct FrameConsistency {
 /// keeps its value bit for bit. Where exposures share latent frames the projections are repeated
 /// until every exposure mean is kept (to 1e-12).
 FrameConsistency KeepFramesConsistent(const Scene& scene, const Video& before, Video* denoised);
+
+/// The latent frames a denoiser has to run on so that the frames flagged in `read` (one flag per
+/// latent frame of `scene`) come out of KeepFramesConsistent as they would with every frame
+/// denoised: the flagged ones, every latent frame of an exposure that holds one of them (its
+/// mean needs them all), and not the latent frame of a sharp frame that no other exposure
+/// holds (its whole correction is taken out). A job that writes only some latent frames (a
+/// video resampled to --fps) denoises these instead of all. Throws InvalidArgumentError when
+/// `read` is not one flag per latent frame.
+std::vector<uint8_t> FramesToDenoise(const Scene& scene, std::vector<uint8_t> read);
 
 }  // namespace evfs
 

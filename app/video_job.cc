@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/frame_consistency.h"
 #include "app/video_writer.h"
 #include "core/error.h"
 #include "core/metrics.h"
@@ -174,6 +175,26 @@ struct WindowContext {
   fs::path work;
 };
 
+// The latent frames of `latent` that the window's output frames [begin, end) and its truth
+// scores read (the two around each time), with what frame consistency needs besides
+// (FramesToDenoise): the only frames the denoiser has to run on. At 240 fps from 48 latent steps
+// per window that is a few frames of each window's dozens.
+std::vector<uint8_t> FramesTheOutputNeeds(const VideoWindow& window, const Scene& scene,
+                                          const Video& latent, const WindowContext& context,
+                                          int64_t begin, int64_t end) {
+  std::vector<uint8_t> read(latent.num_frames(), 0);
+  const auto mark = [&latent, &read](int64_t t_ns) {
+    int before = 0, after = 0;
+    double weight_after = 0.0;
+    latent.InterpolationFrames(t_ns, &before, &after, &weight_after);
+    read[before] = 1;
+    if (weight_after > 0.0) read[after] = 1;
+  };
+  for (int64_t n = begin; n < end; ++n) mark(context.clock->TimeNs(n));
+  for (const int index : window.truth_frames) mark(context.source->unlocked().frames()[index].t_ns);
+  return context.request->denoise.consistency ? FramesToDenoise(scene, read) : read;
+}
+
 // Solves one window, writes the output frames it owns into the work folder and returns its
 // record (written last).
 Json RunWindow(const VideoWindow& window, const WindowContext& context) {
@@ -201,14 +222,18 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
                                why_not);
   }
   MethodResult run = RunMethod(scene, context.method, IterationCallback(), false, nullptr);
+  int64_t begin = 0, end = 0;
+  context.clock->FramesOf(window, &begin, &end);
   double denoise_s = 0.0;
   DenoiseRecord denoise_record;
   if (context.denoiser != nullptr) {
     const auto denoise_start = Clock::now();
+    DenoiseRegion region = SolvedRegion(scene, context.method, run.solved);
+    region.frames = FramesTheOutputNeeds(window, scene, run.video, context, begin, end);
     const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
-    denoise_record = DenoiseLatentVideo(
-        *context.denoiser, request.denoise.mode, SolvedRegion(scene, context.method, run.solved),
-        request.denoise.consistency ? &scene : nullptr, nullptr, -1, &run.video);
+    denoise_record =
+        DenoiseLatentVideo(*context.denoiser, request.denoise.mode, region,
+                           request.denoise.consistency ? &scene : nullptr, nullptr, -1, &run.video);
     denoise_s = SecondsSince(denoise_start);
   }
   ApplySharpFrameSeams(scene, context.method, &run);
@@ -221,8 +246,6 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   }
 
   const auto write_start = Clock::now();
-  int64_t begin = 0, end = 0;
-  context.clock->FramesOf(window, &begin, &end);
   for (int64_t n = begin; n < end; ++n) {
     const fs::path final_path = context.work / "frames" / (FrameName(n) + ".png");
     const fs::path temporary = context.work / "frames" / (FrameName(n) + ".tmp.png");
@@ -263,6 +286,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   if (denoise_record.consistent) {
     record["consistency_removed"] = Number(denoise_record.consistency.RemovedFraction());
   }
+  if (context.denoiser != nullptr) record["denoised_frames"] = denoise_record.stats.frames;
   if (!window.truth_frames.empty()) {
     const Video blend = InitializeLatentVideo(scene);
     Json scores = Json::array();

@@ -39,14 +39,24 @@ int Video::NearestFrame(int64_t t_ns) const {
   return (t_ns - timestamps_ns_[before] <= timestamps_ns_[after] - t_ns) ? before : after;
 }
 
-Image Video::InterpolateAt(int64_t t_ns) const {
+void Video::InterpolationFrames(int64_t t_ns, int* before, int* after, double* weight_after) const {
   const auto upper = std::upper_bound(timestamps_ns_.begin(), timestamps_ns_.end(), t_ns);
-  if (upper == timestamps_ns_.begin()) return frame(0);
-  if (upper == timestamps_ns_.end()) return frame(num_frames() - 1);
-  const int after = static_cast<int>(upper - timestamps_ns_.begin());
-  const int before = after - 1;
-  const double span = static_cast<double>(timestamps_ns_[after] - timestamps_ns_[before]);
-  const double weight_after = static_cast<double>(t_ns - timestamps_ns_[before]) / span;
+  *weight_after = 0.0;
+  if (upper == timestamps_ns_.begin() || upper == timestamps_ns_.end()) {
+    *before = *after = upper == timestamps_ns_.begin() ? 0 : num_frames() - 1;
+    return;
+  }
+  *after = static_cast<int>(upper - timestamps_ns_.begin());
+  *before = *after - 1;
+  const double span = static_cast<double>(timestamps_ns_[*after] - timestamps_ns_[*before]);
+  *weight_after = static_cast<double>(t_ns - timestamps_ns_[*before]) / span;
+}
+
+Image Video::InterpolateAt(int64_t t_ns) const {
+  int before = 0, after = 0;
+  double weight_after = 0.0;
+  InterpolationFrames(t_ns, &before, &after, &weight_after);
+  if (before == after) return frame(before);
   return (1.0 - weight_after) * frame(before) + weight_after * frame(after);
 }
 

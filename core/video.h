@@ -52,6 +52,10 @@ class Video {
   /// Linear interpolation between the two frames around `t_ns` (clamped at the ends).
   Image InterpolateAt(int64_t t_ns) const;
 
+  /// The frames InterpolateAt(t_ns) reads: `*before` and `*after` with `*weight_after` for the
+  /// later one (the same frame twice, weight 0, at or beyond the ends).
+  void InterpolationFrames(int64_t t_ns, int* before, int* after, double* weight_after) const;
+
  private:
   size_t Index(int t, int y, int x) const {
     return static_cast<size_t>(t) * pixels_per_frame() + static_cast<size_t>(y) * width_ + x;

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "core/error.h"
 #include "scene/scene.h"
 #include "tests/scene/scene_test_scenes.h"
@@ -157,6 +160,54 @@ TEST(FrameConsistency, NoCorrectionIsNothingToDo) {
   for (int t = 0; t < c.before.num_frames(); ++t) {
     EXPECT_TRUE((c.denoised.frame(t) == c.before.frame(t)).all());
   }
+}
+
+TEST(FrameConsistency, DenoisingTheFramesToDenoiseGivesTheReadFramesOfDenoisingAll) {
+  // Sharp frames at both ends and a blurred one between them: a window of evfs video.
+  const test::SyntheticRecording& recording = Recording();
+  const TimedFrame first = recording.Sharp(0), last = recording.Sharp(20);
+  Case c(MakeScene({first, recording.Blurred(6, 12), last}, recording.events,
+                   first.exposure_begin_ns, last.exposure_end_ns, BinningOptions()));
+  ASSERT_EQ(c.scene.frames.size(), 3u);
+  const FrameObservation& blurred = c.scene.frames[1];
+  ASSERT_GT(blurred.latent_last, blurred.latent_first + 1);
+  const int n = c.before.num_frames();
+  const int sharp_first = c.scene.frames[0].latent_first;
+  const int sharp_last = c.scene.frames[2].latent_first;
+  // A correction that differs from frame to frame.
+  const Image pattern = Checkerboard(c.scene.height, c.scene.width);
+  const auto correction = [&](int t) { return Image((1.0 + t) * pattern + 0.001 * t * t); };
+  Video all = c.before;
+  for (int t = 0; t < n; ++t) all.frame(t) = c.before.frame(t) - correction(t);
+  KeepFramesConsistent(c.scene, c.before, &all);
+
+  // Read: a frame before the blurred exposure, one inside it and both sharp frames.
+  std::vector<uint8_t> read(n, 0);
+  const int outside = (sharp_first + blurred.latent_first) / 2;
+  ASSERT_NE(outside, sharp_first);
+  const int inside = (blurred.latent_first + blurred.latent_last) / 2;
+  for (const int t : {outside, inside, sharp_first, sharp_last}) read[t] = 1;
+  const std::vector<uint8_t> to_denoise = FramesToDenoise(c.scene, read);
+  ASSERT_EQ(static_cast<int>(to_denoise.size()), n);
+  EXPECT_EQ(to_denoise[outside], 1);
+  EXPECT_EQ(to_denoise[sharp_first], 0);  // its correction is taken out whole
+  EXPECT_EQ(to_denoise[sharp_last], 0);
+  for (int t = blurred.latent_first; t <= blurred.latent_last; ++t) {
+    EXPECT_EQ(to_denoise[t], 1) << "frame " << t << " of the blurred exposure";
+  }
+  EXPECT_EQ(std::count(to_denoise.begin(), to_denoise.end(), 1),
+            1 + blurred.latent_last - blurred.latent_first + 1);
+
+  Video some = c.before;
+  for (int t = 0; t < n; ++t) {
+    if (to_denoise[t] != 0) some.frame(t) = c.before.frame(t) - correction(t);
+  }
+  KeepFramesConsistent(c.scene, c.before, &some);
+  for (int t = 0; t < n; ++t) {
+    if (read[t] == 0) continue;
+    EXPECT_LT((some.frame(t) - all.frame(t)).abs().maxCoeff(), 1e-12) << "frame " << t;
+  }
+  EXPECT_THROW(FramesToDenoise(c.scene, std::vector<uint8_t>(n + 1, 0)), InvalidArgumentError);
 }
 
 TEST(FrameConsistency, VideosOffTheTimelineAreRejected) {

@@ -148,7 +148,7 @@ TEST(EvfsDenoise, VideoWindowsRecordWhatConsistencyTookOut) {
   const CommandResult full =
       RunEvfs(common + " --denoise_consistency=false --out=" + scratch + "/full");
   ASSERT_EQ(full.exit_code, 0) << full.output;
-  int solved = 0;
+  int solved = 0, denoised = 0, latent = 0;
   const nlohmann::json with = ReadSummary(scratch + "/consistent");
   for (const nlohmann::json& window : with["windows"]) {
     if (!window["solved"].get<bool>()) continue;
@@ -156,8 +156,13 @@ TEST(EvfsDenoise, VideoWindowsRecordWhatConsistencyTookOut) {
     ASSERT_TRUE(window.contains("consistency_removed")) << window;
     EXPECT_GE(window["consistency_removed"].get<double>(), 0.0);
     EXPECT_LE(window["consistency_removed"].get<double>(), 1.0);
+    // Only the latent frames the output reads (FramesTheOutputNeeds), never the sharp frames'.
+    denoised += window["denoised_frames"].get<int>();
+    latent += window["latent_frames"].get<int>();
   }
   EXPECT_GT(solved, 0);
+  EXPECT_GT(denoised, 0);
+  EXPECT_LT(denoised, latent);
   const nlohmann::json without = ReadSummary(scratch + "/full");
   for (const nlohmann::json& window : without["windows"]) {
     EXPECT_FALSE(window.contains("consistency_removed")) << window;
