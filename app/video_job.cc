@@ -171,7 +171,6 @@ struct WindowContext {
   const OutputClock* clock = nullptr;
   MethodOptions method;  // with the per-window thread count
   const Denoiser* denoiser = nullptr;
-  std::mutex* denoiser_mutex = nullptr;
   fs::path work;
 };
 
@@ -230,7 +229,6 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     const auto denoise_start = Clock::now();
     DenoiseRegion region = SolvedRegion(scene, context.method, run.solved);
     region.frames = FramesTheOutputNeeds(window, scene, run.video, context, begin, end);
-    const std::lock_guard<std::mutex> lock(*context.denoiser_mutex);
     denoise_record =
         DenoiseLatentVideo(*context.denoiser, request.denoise.mode, region,
                            request.denoise.consistency ? &scene : nullptr, nullptr, -1, &run.video);
@@ -561,8 +559,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   context.method.adam.num_threads = result.threads_per_window;
   context.method.lbfgs.num_threads = result.threads_per_window;
   context.denoiser = denoiser.get();
-  std::mutex denoiser_mutex, progress_mutex;
-  context.denoiser_mutex = &denoiser_mutex;
+  std::mutex progress_mutex;
   context.work = work;
 
   VideoProgress progress;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -259,21 +260,27 @@ bool DenoiserOptions::IsValid(std::string* error) const {
 }
 
 // One copy of the network per thread (a cv::dnn::Net runs one forward at a time), handed out
-// to tasks from a free list.
+// to tasks from a free list. Several Apply calls at once (evfs video's windows) share the
+// copies: a task waits until one is free.
 struct Denoiser::Networks {
   std::mutex mutex;
+  std::condition_variable released;
   std::vector<cv::dnn::Net> nets;
   std::vector<int> free;
 
   int Acquire() {
-    std::lock_guard<std::mutex> lock(mutex);
+    std::unique_lock<std::mutex> lock(mutex);
+    released.wait(lock, [this] { return !free.empty(); });
     const int index = free.back();
     free.pop_back();
     return index;
   }
   void Release(int index) {
-    std::lock_guard<std::mutex> lock(mutex);
-    free.push_back(index);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      free.push_back(index);
+    }
+    released.notify_one();
   }
 };
 

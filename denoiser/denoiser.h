@@ -70,7 +70,8 @@ class Denoiser {
 
   /// `video` with H − R(H) at the pixels of `region` in the frames of `region`; every other
   /// value is copied unchanged. Throws InvalidArgumentError when the region's sizes do not
-  /// match the video.
+  /// match the video. Safe to call from several threads at once: the calls share the network
+  /// copies (num_threads of them), each tile waiting for a free one.
   Video Apply(const Video& video, const DenoiseRegion& region = {},
               DenoiseStats* stats = nullptr) const;
 

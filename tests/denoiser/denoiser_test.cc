@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
+#include <thread>
 
 #include "core/error.h"
 #include "denoiser/sha256.h"
@@ -316,6 +317,31 @@ TEST(DenoiserTest, ThreadsGiveTheSameResult) {
   EXPECT_EQ(std::memcmp(one.data(), three.data(),
                         sizeof(double) * video.pixels_per_frame() * video.num_frames()),
             0);
+}
+
+TEST(DenoiserTest, CallsFromSeveralThreadsShareTheNetworks) {
+  // Four callers at once on one denoiser with two network copies (as evfs video's windows):
+  // every call gives what it gives alone.
+  DenoiserOptions options = TwoConvOptions(1);
+  options.tile_size_px = 16;
+  options.num_threads = 2;
+  const Denoiser denoiser(options);
+  std::vector<Video> videos, alone, together(4);
+  for (int i = 0; i < 4; ++i) {
+    videos.push_back(RandomVideo(48, 64, 6, 10 + i));
+    alone.push_back(denoiser.Apply(videos.back()));
+  }
+  std::vector<std::thread> callers;
+  for (int i = 0; i < 4; ++i) {
+    callers.emplace_back([&, i] { together[i] = denoiser.Apply(videos[i]); });
+  }
+  for (std::thread& caller : callers) caller.join();
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(std::memcmp(alone[i].data(), together[i].data(),
+                          sizeof(double) * videos[i].pixels_per_frame() * videos[i].num_frames()),
+              0)
+        << "caller " << i;
+  }
 }
 
 TEST(DenoiserTest, RegionOfTheWrongSizeIsAnError) {
