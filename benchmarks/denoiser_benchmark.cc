@@ -360,12 +360,11 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
       c.truth_sharpness += LaplacianVariance(clip.frames.frame(t)) / kClipFrames;
     }
     c.sharpness = [frames = clip.frames](const Video& video) {
-      double sharpness = 0.0;
-      for (int t = 0; t < kClipFrames; ++t) {
-        sharpness += LaplacianVariance(video.frame(video.NearestFrame(frames.timestamp_ns(t)))) /
-                     kClipFrames;
-      }
-      return sharpness;
+      SimulatedClip reference;  // ScoreClipDeblur reads only the frames
+      reference.frames = frames;
+      return ScoreClipDeblur(video, reference, [](const Image& estimate, const Image&) {
+        return LaplacianVariance(estimate);
+      });
     };
     c.picture_frame = c.dmr.NearestFrame(clip.frames.timestamp_ns(kClipFrames / 2));
     c.reference = clip.frames.frame(kClipFrames / 2);

@@ -152,7 +152,7 @@ TEST(FrameConsistency, ExposuresSharingLatentFramesAreAllKept) {
   EXPECT_LT(consistency.removed_energy, consistency.correction_energy);
 }
 
-TEST(FrameConsistency, NoCorrectionIsNothingToDo) {
+TEST(FrameConsistency, AVideoTheDenoiserLeftAloneStaysAsItWas) {
   Case c = InterpolationCase();
   const FrameConsistency consistency = KeepFramesConsistent(c.scene, c.before, &c.denoised);
   EXPECT_EQ(consistency.correction_energy, 0.0);
