@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -178,6 +179,46 @@ struct Score {
   double first = 0.0, second = 0.0;  // PSNR and SSIM (cups: re-blur PSNR and sharpness ×1e3)
 };
 
+// Sharpness of some frames: the variance of the Laplacian, in which pixel noise counts as much
+// as edges, and the edge width (EdgeWidth: the 10–90 % rise across the strongest edges, which
+// speckle barely moves; smaller is sharper), pooled over the edges of all the frames.
+struct Sharpness {
+  double laplacian_variance = 0.0;
+  double edge_width_px = 0.0;
+};
+
+// The sharpness of `frames` at the edges of `edges` (one image per frame: the truth, or a
+// reference video's frames).
+Sharpness SharpnessOf(const std::vector<Image>& frames, const std::vector<Image>& edges) {
+  Sharpness sharpness;
+  double width_sum = 0.0;
+  int edge_count = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    sharpness.laplacian_variance += LaplacianVariance(frames[i]) / frames.size();
+    const EdgeWidthScore width = EdgeWidth(frames[i], edges[i]);
+    if (width.edges > 0) width_sum += width.mean_px * width.edges;
+    edge_count += width.edges;
+  }
+  sharpness.edge_width_px =
+      edge_count > 0 ? width_sum / edge_count : std::numeric_limits<double>::quiet_NaN();
+  return sharpness;
+}
+
+// `video`'s frames nearest `times_ns`.
+std::vector<Image> FramesAt(const Video& video, const std::vector<int64_t>& times_ns) {
+  std::vector<Image> frames;
+  for (const int64_t t_ns : times_ns) frames.push_back(video.frame(video.NearestFrame(t_ns)));
+  return frames;
+}
+
+// QualityCase::sharpness for frames with a truth at `times_ns`, and the truth's own.
+std::function<Sharpness(const Video&)> SharpnessAgainst(const std::vector<int64_t>& times_ns,
+                                                        const std::vector<Image>& truth) {
+  return [times_ns, truth](const Video& video) {
+    return SharpnessOf(FramesAt(video, times_ns), truth);
+  };
+}
+
 // A validation case: the DMR, DMR + RD once and DMR + RD plug & play videos, and how a video is
 // scored.
 struct QualityCase {
@@ -192,11 +233,9 @@ struct QualityCase {
   // (the score does not see the others). Empty: every frame.
   std::vector<int> scored_frames;
   std::function<Score(const Video&)> score;
-  // Deblur cases with a truth: the truth's sharpness and a video's at the same frames (variance
-  // of the Laplacian, mean over the scored frames), to read cups' sharpness against. Empty
-  // elsewhere.
-  double truth_sharpness = 0.0;
-  std::function<double(const Video&)> sharpness;
+  // A video's sharpness at the frames the score reads, and the truth's (cups: none).
+  std::function<Sharpness(const Video&)> sharpness;
+  Sharpness truth_sharpness;
   // The picture: latent frame `picture_frame` next to `reference` (the truth, or the blurred
   // input when there is none), labelled `reference_label`.
   int picture_frame = 0;
@@ -302,6 +341,8 @@ QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last
     c.scored_frames = {c.picture_frame};
     c.reference = truth_image;
     c.reference_label = "truth";
+    c.sharpness = SharpnessAgainst({t_ns}, {truth_image});
+    c.truth_sharpness = SharpnessOf({truth_image}, {truth_image});
   } else {
     c.has_truth = false;
     c.metrics = "re-blur PSNR / sharpness x1e3";
@@ -313,6 +354,8 @@ QualityCase DavisCase(const std::string& snippet, Mode mode, int first, int last
     c.picture_frame = c.dmr.num_frames() / 2;
     c.reference = blurred;
     c.reference_label = "blurred input";
+    // No truth: every latent frame, at the DMR's edges.
+    c.sharpness = SharpnessAgainst(c.dmr.timestamps_ns(), FramesAt(c.dmr, c.dmr.timestamps_ns()));
   }
   return c;
 }
@@ -356,16 +399,14 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
     std::sort(c.scored_frames.begin(), c.scored_frames.end());
     c.scored_frames.erase(std::unique(c.scored_frames.begin(), c.scored_frames.end()),
                           c.scored_frames.end());
+    std::vector<int64_t> times_ns;
+    std::vector<Image> truth;
     for (int t = 0; t < kClipFrames; ++t) {
-      c.truth_sharpness += LaplacianVariance(clip.frames.frame(t)) / kClipFrames;
+      times_ns.push_back(clip.frames.timestamp_ns(t));
+      truth.push_back(clip.frames.frame(t));
     }
-    c.sharpness = [frames = clip.frames](const Video& video) {
-      SimulatedClip reference;  // ScoreClipDeblur reads only the frames
-      reference.frames = frames;
-      return ScoreClipDeblur(video, reference, [](const Image& estimate, const Image&) {
-        return LaplacianVariance(estimate);
-      });
-    };
+    c.sharpness = SharpnessAgainst(times_ns, truth);
+    c.truth_sharpness = SharpnessOf(truth, truth);
     c.picture_frame = c.dmr.NearestFrame(clip.frames.timestamp_ns(kClipFrames / 2));
     c.reference = clip.frames.frame(kClipFrames / 2);
   } else {
@@ -376,6 +417,8 @@ QualityCase ClipCase(const std::string& clip_name, bool deblur, const Denoiser& 
     c.picture_frame = c.dmr.NearestFrame(t_ns);
     c.scored_frames = {c.picture_frame};
     c.reference = truth;
+    c.sharpness = SharpnessAgainst({t_ns}, {truth});
+    c.truth_sharpness = SharpnessOf({truth}, {truth});
   }
   c.reference_label = "truth";
   return c;
@@ -545,9 +588,17 @@ void RunQuality() {
           << c.pnp_s << "\n";
     }
     if (c.sharpness) {
-      sharpness_lines.push_back(Format("* %s: truth %.2f, DMR %.2f, DMR + RD once %.2f",
-                                       c.name.c_str(), 1e3 * c.truth_sharpness,
-                                       1e3 * c.sharpness(c.dmr), 1e3 * c.sharpness(c.rd)));
+      const Sharpness before = c.sharpness(c.dmr), after = c.sharpness(c.rd);
+      const std::string truth_lv =
+          c.has_truth ? Format("truth %.2f, ", 1e3 * c.truth_sharpness.laplacian_variance) : "";
+      const std::string truth_width =
+          c.has_truth ? Format("truth %.2f, ", c.truth_sharpness.edge_width_px) : "";
+      sharpness_lines.push_back(
+          Format("* %s: ", c.name.c_str()) + truth_lv +
+          Format("DMR %.2f, DMR + RD once %.2f | ", 1e3 * before.laplacian_variance,
+                 1e3 * after.laplacian_variance) +
+          truth_width +
+          Format("DMR %.2f, DMR + RD once %.2f", before.edge_width_px, after.edge_width_px));
     }
     if (!FLAGS_out.empty()) WritePicture(c, FLAGS_out);
     std::fflush(stdout);
@@ -565,8 +616,10 @@ void RunQuality() {
   summary("DMR + fastNlMeans (tuned on the truth)", nlm_gain);
   if (!sharpness_lines.empty()) {
     std::printf(
-        "\nSharpness of the deblurred frames (variance of the Laplacian x1e3, mean over "
-        "the scored frames; cups reads its own against the DMR's):\n\n");
+        "\nSharpness of the scored frames (cups: every latent frame): the variance of the "
+        "Laplacian x1e3, in which pixel noise counts as much as edges | the edge width in px "
+        "(core/metrics.h EdgeWidth: the 10-90 %% rise across the strongest 3 %% of the truth's "
+        "edges, cups: the DMR's; speckle barely moves it; smaller is sharper):\n\n");
     for (const std::string& line : sharpness_lines) std::printf("%s\n", line.c_str());
   }
 }
