@@ -84,6 +84,14 @@ def main(argv):
         for name in ("reference_input.pfm", "reference_output.pfm"):
             with open(os.path.join(scratch, name), "rb") as f:
                 assert f.read(3) == b"Pf\n", name
+        # Every convolution has its bias input; with --bias_free none has.
+        assert all(len(n.input) == 3 for n in model.graph.node if n.op_type.startswith("Conv"))
+        subprocess.run([sys.executable, train_py, f"--pairs={pairs}", f"--onnx={onnx_path}",
+                        f"--reference_dir={scratch}", "--steps=2", "--held_out_every=2",
+                        "--validate_every=1", "--opencv_runs=1", "--channels=4",
+                        "--coarse_channels=4", "--coarse_depth=1", "--bias_free"], check=True)
+        convolutions = [n for n in onnx.load(onnx_path).graph.node if n.op_type.startswith("Conv")]
+        assert convolutions and all(len(n.input) == 2 for n in convolutions), "biases exported"
         print("train: ok")
         return 0
     sys.exit(f"unknown mode {mode}")

@@ -61,6 +61,9 @@ def parse_args(argv):
                         help="twoscale: channels at half resolution")
     parser.add_argument("--coarse_depth", type=int, default=5,
                         help="twoscale: 3x3 layers at half resolution")
+    parser.add_argument("--bias_free", action="store_true",
+                        help="twoscale: convolutions without biases, so that R(kx) = k R(x) "
+                        "(Mohan et al. 2020); tried, not shipped (models/README.md, Limits)")
     parser.add_argument("--steps", type=int, default=12000, help="optimiser steps")
     parser.add_argument("--batch", type=int, default=64, help="patches per step")
     parser.add_argument("--patch", type=int, default=48, help="patch side in pixels")
@@ -118,17 +121,20 @@ class TwoScaleDenoiser(nn.Module):
     parameters and twice the receptive field. Input height and width must be even (the
     inference module pads them)."""
 
-    def __init__(self, channels, coarse_channels, coarse_depth):
+    def __init__(self, channels, coarse_channels, coarse_depth, bias=True):
         super().__init__()
-        self.head = nn.Sequential(nn.Conv2d(1, channels, 3, padding=1), nn.ReLU())
-        coarse = [nn.Conv2d(channels, coarse_channels, 3, stride=2, padding=1), nn.ReLU()]
+        self.head = nn.Sequential(nn.Conv2d(1, channels, 3, padding=1, bias=bias), nn.ReLU())
+        coarse = [nn.Conv2d(channels, coarse_channels, 3, stride=2, padding=1, bias=bias),
+                  nn.ReLU()]
         for _ in range(coarse_depth):
-            coarse += [nn.Conv2d(coarse_channels, coarse_channels, 3, padding=1), nn.ReLU()]
-        coarse.append(nn.ConvTranspose2d(coarse_channels, channels, 2, stride=2))
+            coarse += [nn.Conv2d(coarse_channels, coarse_channels, 3, padding=1, bias=bias),
+                       nn.ReLU()]
+        coarse.append(nn.ConvTranspose2d(coarse_channels, channels, 2, stride=2, bias=bias))
         self.coarse = nn.Sequential(*coarse)
-        self.tail = nn.Sequential(nn.ReLU(), nn.Conv2d(channels, channels, 3, padding=1),
-                                  nn.ReLU(), nn.Conv2d(channels, 1, 3, padding=1))
+        self.tail = nn.Sequential(nn.ReLU(), nn.Conv2d(channels, channels, 3, padding=1, bias=bias),
+                                  nn.ReLU(), nn.Conv2d(channels, 1, 3, padding=1, bias=bias))
         self.sizes = (channels, coarse_channels, coarse_depth)
+        self.bias = bias
 
     def forward(self, x):
         features = self.head(x)
@@ -140,13 +146,14 @@ class TwoScaleDenoiser(nn.Module):
     def description(self):
         c, cc, depth = self.sizes
         return (f"two-scale residual network, {c} channels at full resolution, {depth} layers "
-                f"of {cc} channels at half resolution, 3x3")
+                f"of {cc} channels at half resolution, 3x3" + ("" if self.bias else ", bias-free"))
 
 
 def make_model(args):
     if args.arch == "dncnn":
         return ResidualDenoiser(args.depth, args.channels)
-    return TwoScaleDenoiser(args.channels, args.coarse_channels, args.coarse_depth)
+    return TwoScaleDenoiser(args.channels, args.coarse_channels, args.coarse_depth,
+                            bias=not args.bias_free)
 
 
 def fused_copy(model):
@@ -373,7 +380,8 @@ def main(argv):
     # Start as the identity: the last layer's weights near zero, so the first steps do not
     # make the DMR worse (the residual is small).
     nn.init.normal_(model.last_layer().weight, std=1e-3)
-    nn.init.zeros_(model.last_layer().bias)
+    if model.last_layer().bias is not None:
+        nn.init.zeros_(model.last_layer().bias)
     parameters = sum(p.numel() for p in model.parameters())
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr, betas=(0.9, 0.999))
     drops = [int(float(f) * args.steps) for f in args.lr_drops.split(",") if f]
