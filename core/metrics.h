@@ -34,9 +34,10 @@ struct EdgeWidthScore {
 /// every 0.1 px over ±6 px; its mean level over the first and last pixel of that profile are 0 %
 /// and 100 %, and an edge whose two levels differ by less than 0.03 in `image` is left out. The
 /// width runs from the first sample at 10 % to the first at 90 % of the profile's running maximum.
-/// A step blurred by a Gaussian of σ s measures 2.56 s. Pass the same `edges_from` to compare
-/// videos at the same edges. Throws InvalidArgumentError when the sizes differ or the images are
-/// smaller than 18x18.
+/// A step blurred by a Gaussian of σ s measures 2.56 s for a wide blur and a little more for a
+/// narrow one, whose pixels the bilinear profile joins by straight lines (2.9 px at σ 1). Pass
+/// the same `edges_from` to compare videos at the same edges. Throws InvalidArgumentError when the
+/// sizes differ or the images are smaller than 18x18.
 EdgeWidthScore EdgeWidth(const Image& image, const Image& edges_from);
 
 }  // namespace evfs
