@@ -23,7 +23,8 @@ FrameConsistency KeepFramesConsistent(const Scene& scene, const Video& before, V
       denoised->num_frames() != before.num_frames() || before.height() != scene.height ||
       before.width() != scene.width || denoised->height() != before.height() ||
       denoised->width() != before.width()) {
-    throw InvalidArgumentError("the videos to keep consistent are not on the scene's timeline");
+    throw InvalidArgumentError(
+        "the videos to keep consistent are not on the scene's latent timeline");
   }
   FrameConsistency consistency;
   consistency.observations = static_cast<int>(scene.frames.size());
@@ -68,13 +69,13 @@ std::vector<uint8_t> FramesToDenoise(const Scene& scene, std::vector<uint8_t> re
   }
   // Grow the flags over whole exposures until none grows (exposures sharing latent frames
   // chain).
+  const auto is_set = [](uint8_t flag) { return flag != 0; };
   for (bool grew = true; grew;) {
     grew = false;
     for (const FrameObservation& frame : scene.frames) {
       if (frame.latent_first == frame.latent_last) continue;
       const auto first = read.begin() + frame.latent_first;
       const auto last = read.begin() + frame.latent_last + 1;
-      const auto is_set = [](uint8_t flag) { return flag != 0; };
       if (std::none_of(first, last, is_set) || std::all_of(first, last, is_set)) continue;
       std::fill(first, last, 1);
       grew = true;
