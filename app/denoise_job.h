@@ -33,10 +33,11 @@ inline constexpr EnumName<DenoiseMode> kDenoiseModeNames[] = {
 /// ../share/evfs/models, or in the source tree evfs was built from. "" when none exists.
 std::string ShippedDenoiserWeights();
 
-/// What `--denoise=auto` does with the shipped weights: the mode that measured best against the
-/// reconstruction alone on the validation cases (BENCHMARKS.md, "Residual denoiser"): once, with
-/// the correction kept consistent with the frames.
-inline constexpr DenoiseMode kShippedWeightsDenoiseMode = DenoiseMode::kOnce;
+/// What `--denoise=auto` does with the shipped weights: none. The shipped network learned from
+/// simulated events only; on real recordings it widens edges and lowers SSIM against the
+/// reconstruction alone (BENCHMARKS.md, "Real windows"), and a default must not lose on real
+/// data. `--denoise=once` still applies it.
+inline constexpr DenoiseMode kShippedWeightsDenoiseMode = DenoiseMode::kNone;
 
 /// `--denoise=auto`: once when the user names weights (`weights_path` not empty: they asked for
 /// a denoiser), kShippedWeightsDenoiseMode when weights are shipped, else none.

@@ -73,6 +73,8 @@ ProgramHelp MakeEvfsHelp() {
       {"min_latent_steps", "binning", "info reconstruct video"},
       {"max_latent_voxels", "binning", "info reconstruct video"},
       {"hot_pixel_factor", "binning", "info reconstruct video"},
+      {"saturation_level", "binning", "info reconstruct video"},
+      {"flicker_min_reversals", "binning", "info reconstruct video"},
       {"noise_filter_ms", "binning", "info reconstruct video"},
       {"stacked_frames", "binning", "info reconstruct video"},
       // The objective and the unknowns.
@@ -120,6 +122,7 @@ ProgramHelp MakeEvfsHelp() {
       {"predict_tail", "data", "video"},
       {"predict_max_s", "data", "video"},
       {"min_blur_exposure_s", "data", "video"},
+      {"blur_from_data", "data", "video"},
       {"frame_step", "data", "video"},
       {"skip_bad_frames", "data", "video"},
       // The event simulator.

@@ -180,4 +180,16 @@ void ApplySharpFrameSeams(const Scene& scene, const MethodOptions& options, Meth
   result->seams = MeetSharpFrames(scene, &result->video);
 }
 
+ConfidenceOptions ConfidenceFor(const MethodOptions& method, const MethodResult& run) {
+  ConfidenceOptions options;
+  const EventModelParams& params = method.reconstruction.objective.event_model;
+  const EventModelEstimate& model = run.reconstruction.model;
+  if (params.model == EventModel::kLog) options.log_offset = params.log_offset;
+  if (model.change_per_event > 0.0 && params.model == EventModel::kLog) {
+    options.change_per_event = model.change_per_event;
+    options.off_change_ratio = 1.0 / model.off_alpha_ratio;
+  }
+  return options;
+}
+
 }  // namespace evfs

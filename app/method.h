@@ -17,6 +17,7 @@
 #include "baselines/baseline_options.h"
 #include "core/enum_names.h"
 #include "core/video.h"
+#include "scene/confidence.h"
 #include "scene/scene.h"
 #include "solver/first_order_solvers.h"
 #include "solver/iteration_callback.h"
@@ -110,6 +111,11 @@ struct MethodResult {
   /// What ApplySharpFrameSeams() did (nothing before it runs).
   SharpFrameSeams seams;
 };
+
+/// The confidence model's options for a method's run (scene/confidence.h): the event model's
+/// change per event and log offset where the run derived them (the log model), else
+/// ConfidenceOptions' defaults.
+ConfidenceOptions ConfidenceFor(const MethodOptions& method, const MethodResult& run);
 
 /// Runs `options.method` on `scene`. `progress` (may be empty) sees every iteration of an
 /// iterative method. With `truth` (may be null) and `record_checkpoints`, every iteration's

@@ -215,6 +215,10 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   result.hot_pixels = static_cast<int>(scene.hot_pixels.size());
   result.hot_pixel_events = scene.hot_pixel_events;
   result.noise_events = scene.noise_events;
+  result.saturated_pixels = static_cast<int>(scene.saturated_pixels.size());
+  result.saturated_pixel_events = scene.saturated_pixel_events;
+  result.flickering_pixels = static_cast<int>(scene.flickering_pixels.size());
+  result.flickering_pixel_events = scene.flickering_pixel_events;
   result.time.bin_s = SecondsSince(bin_start);
 
   result.baseline = InitializeLatentVideo(scene);
@@ -259,6 +263,9 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   ApplySharpFrameSeams(scene, request.method, &result.run);
   const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
+  const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(request.method, result.run),
+                                        &result.confidence_model);
+  result.confidence = request.fps > 0.0 ? Resample(sigma, request.fps) : sigma;
 
   if (request.truth >= 0) {
     TruthScore& truth = result.truth;
@@ -270,6 +277,8 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
     const Image baseline = result.baseline.frame(truth.latent_index);
     truth.baseline_psnr = Psnr(baseline, truth_image);
     truth.baseline_ssim = Ssim(baseline, truth_image);
+    result.truth_within_sigma =
+        ShareWithinSigma(estimate, truth_image, sigma.frame(truth.latent_index));
     result.has_truth = true;
   }
   result.time.total_s = SecondsSince(total_start);
@@ -391,6 +400,13 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json["hot_pixels"] = result.hot_pixels;
   json["hot_pixel_events"] = result.hot_pixel_events;
   json["noise_events"] = result.noise_events;
+  // Pixels where the frames govern: their events were left out, rule by rule.
+  json["frames_govern"] = {
+      {"hot", {{"pixels", result.hot_pixels}, {"events", result.hot_pixel_events}}},
+      {"saturated",
+       {{"pixels", result.saturated_pixels}, {"events", result.saturated_pixel_events}}},
+      {"flickering",
+       {{"pixels", result.flickering_pixels}, {"events", result.flickering_pixel_events}}}};
   json["event_frames"] = result.event_frames;
   json["latent_frames"] = run.video.num_frames();
   json["output_frames"] = result.output.num_frames();
@@ -444,6 +460,12 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
       {"write", Number(result.time.write_s)}, {"total", Number(result.time.total_s)},
   };
   json["denoiser"] = DenoiseJson(result.denoise);
+  json["confidence"] = {
+      {"folder", "confidence"},
+      {"meaning",
+       "predicted one-sigma error of each output pixel's intensity (scene/confidence.h)"},
+      {"scale", "sigma = png value / 65535, intensities in [0, 1]"},
+      {"model", result.confidence_model.description}};
   if (result.has_truth) {
     const TruthScore& truth = result.truth;
     json["truth"] = {
@@ -455,6 +477,7 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
         {"baseline", result.mode == Mode::kInterpolate ? "blend" : "copy"},
         {"baseline_psnr", Number(truth.baseline_psnr)},
         {"baseline_ssim", Number(truth.baseline_ssim)},
+        {"within_predicted_sigma", Number(result.truth_within_sigma)},
     };
   }
   if (!run.checkpoints.empty()) {
@@ -480,6 +503,7 @@ void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* r
   const auto write_start = Clock::now();
   const fs::path out(folder);
   WriteFrameSequence(folder, result->output);
+  WriteImageSequence((out / "confidence").string(), result->confidence);
   result->time.write_s = SecondsSince(write_start);
   result->time.total_s += result->time.write_s;
   std::ofstream summary(out / "summary.json");

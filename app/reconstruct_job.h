@@ -13,6 +13,7 @@
 #include "core/enum_names.h"
 #include "core/video.h"
 #include "io/data_source.h"
+#include "scene/confidence.h"
 #include "scene/frame_timing.h"
 #include "scene/scene.h"
 
@@ -80,11 +81,20 @@ struct ReconstructResult {
   int hot_pixels = 0;            // pixels whose events were left out as hot (BinningOptions)
   int64_t hot_pixel_events = 0;  // their events
   int64_t noise_events = 0;      // left out by the background-activity filter
-  MethodResult run;              // latent video and what the method did
-  Video output;                  // the latent video, or its resampling at request.fps
-  Video baseline;                // blend or copy on the latent timeline (the score's reference)
+  int saturated_pixels = 0;      // pixels whose events were left out: a frame saturates there
+  int64_t saturated_pixel_events = 0;
+  int flickering_pixels = 0;  // pixels whose events were left out: they flicker
+  int64_t flickering_pixel_events = 0;
+  MethodResult run;  // latent video and what the method did
+  Video output;      // the latent video, or its resampling at request.fps
+  /// The predicted one-sigma error of every pixel of `output` (scene/confidence.h).
+  Video confidence;
+  ConfidenceModel confidence_model;
+  Video baseline;  // blend or copy on the latent timeline (the score's reference)
   bool has_truth = false;
   TruthScore truth;
+  /// With a truth: the share of its pixels whose error lies within the predicted one sigma.
+  double truth_within_sigma = 0.0;
   StageTimes time;
   DenoiseRecord denoise;  // what the denoiser did (mode none: nothing)
   /// request.frame_time kAuto: the estimate; frame_shift_ns: how far the moment a sharp frame

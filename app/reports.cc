@@ -66,7 +66,10 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
   }
   const int64_t begin_ns = source.frames()[first].t_ns, end_ns = source.frames()[last].t_ns;
   const EventStream window = source.ReadEvents(begin_ns, end_ns);
-  const BinningPlan plan = PlanBinning(window, begin_ns, end_ns, binning);
+  const Image first_image = source.ReadImage(first);
+  const Image last_image = source.ReadImage(last);
+  const BinningPlan plan =
+      PlanBinning(window, begin_ns, end_ns, binning, {&first_image, &last_image});
   const PixelActivity& activity = plan.activity;
   const size_t positive = window.CountPositive();
   std::string left_out;  // what the binning leaves out
@@ -86,6 +89,13 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
       window.size() - positive, static_cast<long long>(activity.pixels_fired),
       100.0 * static_cast<double>(activity.pixels_fired) / static_cast<double>(plan.pixels),
       static_cast<long long>(plan.collision_frames), left_out.c_str());
+  // Where the frames govern: pixels whose events the window leaves out, rule by rule.
+  std::fprintf(out,
+               "frames rule hot %zu pixels (%lld events), saturated %zu (%lld), flickering %zu "
+               "(%lld)\n",
+               activity.hot_pixels.size(), static_cast<long long>(activity.hot_pixel_events),
+               plan.saturated_pixels.size(), static_cast<long long>(plan.saturated_pixel_events),
+               plan.flickering_pixels.size(), static_cast<long long>(plan.flickering_pixel_events));
   const bool split = plan.method == BinningOptions::Method::kCollision &&
                      plan.num_event_frames > plan.collision_frames;
   std::fprintf(out,
@@ -96,8 +106,8 @@ void PrintWindow(const DataSource& source, int first, int last, const BinningOpt
                static_cast<long long>(binning.max_latent_voxels));
   // A change of overall brightness between the frames (flicker, exposure or gain) that no
   // event records is outside the per-pixel event model; this line shows it.
-  const double first_mean = source.ReadImage(first).mean();
-  const double last_mean = source.ReadImage(last).mean();
+  const double first_mean = first_image.mean();
+  const double last_mean = last_image.mean();
   std::fprintf(out, "brightness  frame %d mean %.3f, frame %d mean %.3f (%+.1f %%)\n", first,
                first_mean, last, last_mean, 100.0 * (last_mean / first_mean - 1.0));
   // When the frames show the scene relative to their timestamps, from the events between each
@@ -151,6 +161,15 @@ void PrintReconstruction(const ReconstructRequest& request, const ReconstructRes
   if (result.hot_pixels > 0) {
     std::fprintf(out, "hot pixels: %d, their %lld events left out (--hot_pixel_factor)\n",
                  result.hot_pixels, static_cast<long long>(result.hot_pixel_events));
+  }
+  if (result.saturated_pixels > 0) {
+    std::fprintf(out, "saturated pixels: %d, their %lld events left out (--saturation_level)\n",
+                 result.saturated_pixels, static_cast<long long>(result.saturated_pixel_events));
+  }
+  if (result.flickering_pixels > 0) {
+    std::fprintf(out,
+                 "flickering pixels: %d, their %lld events left out (--flicker_min_reversals)\n",
+                 result.flickering_pixels, static_cast<long long>(result.flickering_pixel_events));
   }
   if (result.noise_events > 0) {
     std::fprintf(out, "noise: %lld unsupported events left out (--noise_filter_ms)\n",

@@ -24,6 +24,7 @@
 #include "core/time.h"
 #include "io/data_source.h"
 #include "io/image_io.h"
+#include "scene/confidence.h"
 #include "scene/scene.h"
 
 namespace evfs {
@@ -115,6 +116,7 @@ std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string&
   if (exists) fs::remove_all(folder, error);
   if (error || !fs::create_directory(folder, error) || error ||
       !fs::create_directory(folder / "frames", error) ||
+      !fs::create_directory(folder / "confidence", error) ||
       !fs::create_directory(folder / "windows", error)) {
     throw InputError(InputError::Kind::kUnwritable, folder.string(), 0,
                      "cannot create the work folder: " + error.message());
@@ -243,15 +245,21 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     if (latent.timestamp_ns(at) == window.frames[k].t_ns) latent.frame(at) = frames[k].image;
   }
 
+  const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(context.method, run));
+
   const auto write_start = Clock::now();
-  for (int64_t n = begin; n < end; ++n) {
-    const fs::path final_path = context.work / "frames" / (FrameName(n) + ".png");
-    const fs::path temporary = context.work / "frames" / (FrameName(n) + ".tmp.png");
-    WriteGreyPng16(temporary.string(), latent.InterpolateAt(context.clock->TimeNs(n)));
-    std::error_code error;
-    fs::rename(temporary, final_path, error);
-    if (error) {
-      throw InputError(InputError::Kind::kUnwritable, final_path.string(), 0, error.message());
+  // The confidence map first: a frame whose image exists is complete (--resume reads that).
+  for (const auto& [folder, video] :
+       {std::pair<const char*, const Video*>{"confidence", &sigma}, {"frames", &latent}}) {
+    for (int64_t n = begin; n < end; ++n) {
+      const fs::path final_path = context.work / folder / (FrameName(n) + ".png");
+      const fs::path temporary = context.work / folder / (FrameName(n) + ".tmp.png");
+      WriteGreyPng16(temporary.string(), video->InterpolateAt(context.clock->TimeNs(n)));
+      std::error_code error;
+      fs::rename(temporary, final_path, error);
+      if (error) {
+        throw InputError(InputError::Kind::kUnwritable, final_path.string(), 0, error.message());
+      }
     }
   }
   const double write_s = SecondsSince(write_start);
@@ -271,6 +279,8 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["output_frames"] = {begin, end};
   record["events"] = scene.num_events;
   record["hot_pixels"] = scene.hot_pixels.size();
+  record["saturated_pixels"] = scene.saturated_pixels.size();
+  record["flickering_pixels"] = scene.flickering_pixels.size();
   record["noise_events"] = scene.noise_events;
   record["event_frames"] = scene.events.num_frames();
   record["latent_frames"] = latent.num_frames();
@@ -296,6 +306,8 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
       scores.push_back({{"index", index},
                         {"psnr", Number(Psnr(estimate, truth))},
                         {"ssim", Number(Ssim(estimate, truth))},
+                        {"within_predicted_sigma",
+                         Number(ShareWithinSigma(estimate, truth, sigma.InterpolateAt(t_ns)))},
                         {"blend_psnr", Number(Psnr(blended, truth))},
                         {"blend_ssim", Number(Ssim(blended, truth))}});
     }
@@ -459,6 +471,16 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
       }
     }
   }
+  if (window_options.blur_from_data && data.has_events()) {
+    for (const int i : SelectedFrames(static_cast<int>(data.frames().size()), window_options)) {
+      int64_t begin_ns = 0, end_ns = 0;
+      if (!BlurCandidateExposure(data.frames()[i], window_options, &begin_ns, &end_ns)) continue;
+      const ExposureBlurEstimate estimate = ExposureBlur(
+          source.ReadImage(i), source.ReadEvents(begin_ns, end_ns + 1), begin_ns, end_ns);
+      if (!estimate.blurred) window_options.sharp_frames.push_back(i);
+      result.exposure_tests.emplace_back(i, estimate);
+    }
+  }
   // The prediction tail ends at the last event: planned first against a far end, then once
   // more against the last event actually found there.
   std::vector<VideoWindow> windows =
@@ -618,9 +640,12 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   // Assembly, in the OutputTarget's staging folder.
   const fs::path out = staging;
   fs::create_directories(out / "frames");
+  fs::create_directories(out / "confidence");
   std::vector<int64_t> times;
   for (int64_t n = 0; n < result.output_frames; ++n) {
-    LinkFrame(work / "frames" / (FrameName(n) + ".png"), out / "frames" / (FrameName(n) + ".png"));
+    for (const char* folder : {"frames", "confidence"}) {
+      LinkFrame(work / folder / (FrameName(n) + ".png"), out / folder / (FrameName(n) + ".png"));
+    }
     times.push_back(clock.TimeNs(n));
   }
   WriteTimestampsTxt((out / "timestamps.txt").string(), times);
@@ -635,7 +660,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   if (request.preview) WritePreview(windows, source, clock, fps, work, out / "preview.mp4");
 
   Json window_records = Json::array();
-  std::vector<double> psnr, ssim, blend_psnr, blend_ssim;
+  std::vector<double> psnr, ssim, blend_psnr, blend_ssim, within_sigma;
   for (int i = 0; i < result.windows; ++i) {
     const Json& record = records.at(i);
     result.events += record["events"].get<int64_t>();
@@ -647,6 +672,8 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                                                              : 0.0);
         blend_ssim.push_back(score["blend_ssim"].is_number() ? score["blend_ssim"].get<double>()
                                                              : 0.0);
+        if (score.contains("within_predicted_sigma") && score["within_predicted_sigma"].is_number())
+          within_sigma.push_back(score["within_predicted_sigma"].get<double>());
       }
     }
     window_records.push_back(record);
@@ -666,6 +693,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   result.worst_ssim = worst(ssim);
   result.mean_blend_psnr = mean(blend_psnr);
   result.mean_blend_ssim = mean(blend_ssim);
+  result.mean_within_sigma = mean(within_sigma);
   result.total_wall_s = SecondsSince(total_start);
 
   Json summary;
@@ -679,6 +707,11 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   summary["resampling"] =
       "linear between the two latent frames around each output time; sharp observed frames "
       "exact at their own times";
+  summary["confidence"] = {
+      {"folder", "confidence"},
+      {"meaning",
+       "predicted one-sigma error of each output pixel's intensity (scene/confidence.h)"},
+      {"scale", "sigma = png value / 65535, intensities in [0, 1]"}};
   summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
   if (request.preview) summary["preview"] = "preview.mp4";
   summary["solver"] = MethodName(request.method.method);
@@ -686,6 +719,17 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
       denoiser != nullptr ? NameOf(kDenoiseModeNames, request.denoise.mode) : "none";
   summary["events"] = result.events;
   summary["skipped_frames"] = result.skipped_frames;
+  if (!result.exposure_tests.empty()) {
+    // Whether each exposure blurred its frame, decided from the frame and its events.
+    Json tests = Json::array();
+    for (const auto& [index, estimate] : result.exposure_tests) {
+      tests.push_back({{"frame", index},
+                       {"blurred", estimate.blurred},
+                       {"predicted_blur_rms", Number(estimate.predicted_blur_rms)},
+                       {"noise_sigma", Number(estimate.noise_sigma)}});
+    }
+    summary["exposures"] = std::move(tests);
+  }
   if (result.truth_frames > 0) {
     summary["truth"] = {{"frames", result.truth_frames},
                         {"mean_psnr", Number(result.mean_psnr)},
@@ -693,7 +737,8 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                         {"mean_ssim", Number(result.mean_ssim)},
                         {"worst_ssim", Number(result.worst_ssim)},
                         {"blend_mean_psnr", Number(result.mean_blend_psnr)},
-                        {"blend_mean_ssim", Number(result.mean_blend_ssim)}};
+                        {"blend_mean_ssim", Number(result.mean_blend_ssim)},
+                        {"mean_within_predicted_sigma", Number(result.mean_within_sigma)}};
   }
   summary["run"] = {{"jobs", result.jobs},
                     {"threads_per_window", result.threads_per_window},

@@ -24,12 +24,14 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/denoise_job.h"
 #include "app/method.h"
 #include "app/video_windows.h"
 #include "events/binning.h"
+#include "scene/exposure_blur.h"
 
 namespace evfs {
 
@@ -90,6 +92,8 @@ struct VideoResult {
   int windows = 0;
   int windows_resumed = 0;
   std::vector<int> skipped_frames;  // left out as unreadable (--skip_bad_frames)
+  /// Frames whose exposure was tested (VideoWindowOptions::blur_from_data) and what was found.
+  std::vector<std::pair<int, ExposureBlurEstimate>> exposure_tests;
   int64_t output_frames = 0;
   int64_t events = 0;  // events of all windows
   int jobs = 0, threads_per_window = 0;
@@ -101,6 +105,8 @@ struct VideoResult {
   int truth_frames = 0;  // withheld frames scored (frame_step > 1)
   double mean_psnr = 0.0, worst_psnr = 0.0, mean_blend_psnr = 0.0;
   double mean_ssim = 0.0, worst_ssim = 0.0, mean_blend_ssim = 0.0;
+  /// The share of the withheld frames' pixels within the predicted one sigma, averaged.
+  double mean_within_sigma = 0.0;
 };
 
 /// The work folder of the video written to `out_path` (absolute, as OutputTarget::path()).

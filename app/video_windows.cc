@@ -20,17 +20,10 @@ VideoWindowFrame ObservedFrame(const std::vector<FrameInfo>& frames, int index,
   frame.index = index;
   frame.t_ns = info.t_ns;
   frame.exposure_begin_ns = frame.exposure_end_ns = info.t_ns;
-  int64_t begin_ns = info.t_ns, end_ns = info.t_ns;
-  if (info.has_exposure) {
-    begin_ns = info.exposure_begin_ns;
-    end_ns = info.exposure_end_ns;
-  } else if (options.exposure_s > 0.0) {
-    const int64_t half_ns = SecondsToNanoseconds(options.exposure_s / 2.0);
-    begin_ns = info.t_ns - half_ns;
-    end_ns = info.t_ns + half_ns;
-  }
-  const int64_t min_ns = SecondsToNanoseconds(options.min_blur_exposure_s);
-  if (end_ns > begin_ns && end_ns - begin_ns >= min_ns) {
+  int64_t begin_ns = 0, end_ns = 0;
+  const bool found_sharp = std::find(options.sharp_frames.begin(), options.sharp_frames.end(),
+                                     index) != options.sharp_frames.end();
+  if (BlurCandidateExposure(info, options, &begin_ns, &end_ns) && !found_sharp) {
     frame.blurred = true;
     frame.exposure_begin_ns = begin_ns;
     frame.exposure_end_ns = end_ns;
@@ -49,6 +42,33 @@ int64_t MedianGapNs(const std::vector<FrameInfo>& frames, const std::vector<int>
 }
 
 }  // namespace
+
+bool BlurCandidateExposure(const FrameInfo& info, const VideoWindowOptions& options,
+                           int64_t* begin_ns, int64_t* end_ns) {
+  *begin_ns = *end_ns = info.t_ns;
+  if (info.has_exposure) {
+    *begin_ns = info.exposure_begin_ns;
+    *end_ns = info.exposure_end_ns;
+  } else if (options.exposure_s > 0.0) {
+    const int64_t half_ns = SecondsToNanoseconds(options.exposure_s / 2.0);
+    *begin_ns = info.t_ns - half_ns;
+    *end_ns = info.t_ns + half_ns;
+  }
+  const int64_t min_ns = SecondsToNanoseconds(options.min_blur_exposure_s);
+  return *end_ns > *begin_ns && *end_ns - *begin_ns >= min_ns;
+}
+
+std::vector<int> SelectedFrames(int frame_count, const VideoWindowOptions& options) {
+  const int last = options.last >= 0 ? std::min(options.last, frame_count - 1) : frame_count - 1;
+  std::vector<int> selected;
+  for (int i = std::max(options.first, 0); i <= last; i += std::max(options.frame_step, 1)) {
+    if (std::find(options.excluded_frames.begin(), options.excluded_frames.end(), i) ==
+        options.excluded_frames.end()) {
+      selected.push_back(i);
+    }
+  }
+  return selected;
+}
 
 bool VideoWindowOptions::IsValid(std::string* error) const {
   OptionChecker check;
@@ -85,10 +105,7 @@ std::vector<VideoWindow> PlanVideoWindows(const std::vector<FrameInfo>& frames, 
     return std::find(options.excluded_frames.begin(), options.excluded_frames.end(), index) !=
            options.excluded_frames.end();
   };
-  std::vector<int> observed;
-  for (int i = first; i <= last; i += options.frame_step) {
-    if (!excluded(i)) observed.push_back(i);
-  }
+  const std::vector<int> observed = SelectedFrames(count, options);
   if (observed.empty()) {
     throw InvalidArgumentError("every selected frame is left out: nothing to start from");
   }

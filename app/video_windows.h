@@ -80,9 +80,25 @@ struct VideoWindowOptions {
   int frame_step = 1;
   /// Frames left out altogether (unreadable ones, with --skip_bad_frames): windows span the gap.
   std::vector<int> excluded_frames;
+  /// Frames observed at their timestamp although their exposure is known and long enough: the
+  /// data shows that the exposure did not blur them (scene/exposure_blur.h).
+  std::vector<int> sharp_frames;
+  /// Decide from each frame and the events inside its exposure whether the exposure blurred it
+  /// (RunVideo fills sharp_frames); false: every frame with a long enough exposure is blurred.
+  bool blur_from_data = true;
 
   bool IsValid(std::string* error) const;
 };
+
+/// The exposure [*begin_ns, *end_ns] that frame `info` would be observed over as a blurred frame:
+/// its known exposure, or options.exposure_s around its timestamp. True when that exposure is
+/// not empty and at least options.min_blur_exposure_s long; sharp_frames is not consulted.
+bool BlurCandidateExposure(const FrameInfo& info, const VideoWindowOptions& options,
+                           int64_t* begin_ns, int64_t* end_ns);
+
+/// The frames a plan observes: every frame_step-th from options.first up to options.last (or
+/// the last of `frame_count`), less the excluded ones.
+std::vector<int> SelectedFrames(int frame_count, const VideoWindowOptions& options);
 
 /// Plans the windows of frames options.first … options.last of `frames` (strictly increasing
 /// timestamps, as DataSource gives them). `last_event_ns` is the time of the recording's last

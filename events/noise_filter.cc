@@ -1,6 +1,7 @@
 #include "events/noise_filter.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -66,6 +67,35 @@ EventStream WithoutUnsupportedEvents(const EventStream& events, int64_t window_n
   }
   if (removed != nullptr) *removed = static_cast<int64_t>(events.size() - count);
   return kept;
+}
+
+std::vector<int32_t> FindFlickeringPixels(const EventStream& events, int64_t t_begin_ns,
+                                          int64_t t_end_ns, int min_reversals, int64_t* events_at) {
+  if (events_at != nullptr) *events_at = 0;
+  std::vector<int32_t> flickering;
+  if (min_reversals <= 0 || events.empty()) return flickering;
+  const int width = events.width();
+  const int height = events.height();
+  const size_t pixels = static_cast<size_t>(width) * height;
+  std::vector<int32_t> count(pixels, 0), net(pixels, 0), reversals(pixels, 0);
+  std::vector<int8_t> last(pixels, 0);
+  const size_t end = events.LowerBound(t_end_ns);
+  for (size_t i = events.LowerBound(t_begin_ns); i < end; ++i) {
+    if (events.x(i) >= width || events.y(i) >= height) continue;
+    const size_t p = static_cast<size_t>(events.y(i)) * width + events.x(i);
+    const int8_t polarity = events.polarity(i) > 0 ? 1 : -1;
+    if (last[p] != 0 && last[p] != polarity) ++reversals[p];
+    last[p] = polarity;
+    ++count[p];
+    net[p] += polarity;
+  }
+  for (size_t p = 0; p < pixels; ++p) {
+    if (reversals[p] >= min_reversals && 4 * std::abs(net[p]) <= count[p]) {
+      flickering.push_back(static_cast<int32_t>(p));
+      if (events_at != nullptr) *events_at += count[p];
+    }
+  }
+  return flickering;
 }
 
 }  // namespace evfs

@@ -122,6 +122,14 @@ DEFINE_double(hot_pixel_factor, evfs::BinningOptions().hot_pixel_factor,
               "Leave out the events of hot pixels: those firing more than this many times as "
               "often as the window's busy pixels (the busiest outside the top 1 %); 0 keeps "
               "every event.");
+DEFINE_double(saturation_level, evfs::BinningOptions().saturation_level,
+              "Leave out the events of pixels at or above this level (intensity in [0, 1]) in "
+              "any frame of the window: a saturated frame cannot show what they record, so the "
+              "frames govern there; above 1 keeps every event.");
+DEFINE_int32(flicker_min_reversals, evfs::BinningOptions().flicker_min_reversals,
+             "Leave out the events of pixels whose events reverse polarity at least this many "
+             "times in the window with almost no net change (a blinking LED, a mains-powered "
+             "lamp), so the frames govern there; 0 keeps them.");
 DEFINE_double(noise_filter_ms, evfs::BinningOptions().noise_filter_ms,
               "Leave out events that no neighbouring pixel confirms within this many ms "
               "(background-activity filter); 0 keeps every event.");
@@ -223,8 +231,8 @@ DEFINE_bool(progress, false,
 DEFINE_string(denoise, "auto",
               "reconstruct: none | once (the residual denoiser after the solve) | pnp (plug & "
               "play: ADMM between the Ceres problem and the denoiser, ceres_lm only) | auto "
-              "(once when --denoiser is given; with the shipped weights the mode that measured "
-              "best, BENCHMARKS.md: once).");
+              "(once when --denoiser is given; otherwise none: the shipped network, trained on "
+              "simulated events, softens real recordings; README \"Residual denoiser\").");
 DEFINE_string(denoiser, "",
               "The denoiser's ONNX weights (reconstruct, denoise); empty: the shipped "
               "models/evfs_denoiser.onnx.");
@@ -253,6 +261,11 @@ DEFINE_double(predict_max_s, 0.0,
 DEFINE_double(min_blur_exposure_s, 0.0,
               "video: a frame whose exposure is at least this long is deblurred (observed over "
               "its exposure); 0: every frame with a known exposure.");
+DEFINE_bool(blur_from_data, evfs::VideoWindowOptions().blur_from_data,
+            "video: decide from each frame and the events inside its exposure whether the "
+            "exposure blurred it (the blur the events predict against the frame's own noise); "
+            "false: every frame with a known exposure of at least --min_blur_exposure_s is "
+            "blurred.");
 DEFINE_int32(frame_step, 1,
              "video: observe every N-th frame and score the frames between (ground truth); 1: "
              "every frame.");
@@ -295,6 +308,8 @@ BinningOptions BinningFromFlags() {
   binning.min_latent_steps = FLAGS_min_latent_steps;
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
+  binning.saturation_level = FLAGS_saturation_level;
+  binning.flicker_min_reversals = FLAGS_flicker_min_reversals;
   binning.noise_filter_ms = FLAGS_noise_filter_ms;
   binning.stacked.num_frames = FLAGS_stacked_frames;
   return binning;
@@ -513,6 +528,7 @@ int RunVideoCommand(ProgressReporter* progress) {
   request.windows.predict_tail = FLAGS_predict_tail;
   request.windows.predict_max_s = FLAGS_predict_max_s;
   request.windows.min_blur_exposure_s = FLAGS_min_blur_exposure_s;
+  request.windows.blur_from_data = FLAGS_blur_from_data;
   request.windows.exposure_s = FLAGS_exposure_s;
   request.windows.frame_step = FLAGS_frame_step;
   request.fps = FLAGS_fps;

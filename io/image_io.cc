@@ -115,8 +115,8 @@ void WriteTimestampsTxt(const std::string& path, const std::vector<int64_t>& t_n
   writer.Close();
 }
 
-void WriteFrameSequence(const std::string& folder, const Video& video) {
-  const std::filesystem::path frames = std::filesystem::path(folder) / "frames";
+void WriteImageSequence(const std::string& folder, const Video& video) {
+  const std::filesystem::path frames(folder);
   std::error_code error;
   std::filesystem::create_directories(frames, error);
   if (error) {
@@ -128,6 +128,10 @@ void WriteFrameSequence(const std::string& folder, const Video& video) {
     std::snprintf(name, sizeof(name), "%06d.png", t);
     WriteGreyPng16((frames / name).string(), video.frame(t));
   }
+}
+
+void WriteFrameSequence(const std::string& folder, const Video& video) {
+  WriteImageSequence((std::filesystem::path(folder) / "frames").string(), video);
   WriteTimestampsTxt((std::filesystem::path(folder) / "timestamps.txt").string(),
                      video.timestamps_ns());
 }

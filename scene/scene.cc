@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "core/error.h"
@@ -17,19 +18,85 @@ std::string VoxelCount(int64_t latent_frames, int64_t pixels) {
          " pixels = " + std::to_string(latent_frames * pixels) + " voxels";
 }
 
-// PlanBinning; *binned receives the events it bins: `events`, or *kept when hot pixels or
-// unsupported events were left out.
+// The pixels at or above `level` in any of `frames`, row-major and ascending.
+std::vector<int32_t> SaturatedPixels(const std::vector<const Image*>& frames, int width, int height,
+                                     double level) {
+  std::vector<int32_t> saturated;
+  if (level > 1.0) return saturated;
+  const int64_t pixels = static_cast<int64_t>(width) * height;
+  for (const Image* frame : frames) {
+    if (frame->rows() != height || frame->cols() != width) {
+      throw InvalidArgumentError("a frame is " + std::to_string(frame->cols()) + "x" +
+                                 std::to_string(frame->rows()) + " but the event sensor is " +
+                                 std::to_string(width) + "x" + std::to_string(height));
+    }
+  }
+  for (int64_t p = 0; p < pixels; ++p) {
+    for (const Image* frame : frames) {
+      if (frame->data()[p] >= level) {
+        saturated.push_back(static_cast<int32_t>(p));
+        break;
+      }
+    }
+  }
+  return saturated;
+}
+
+// The events in [begin_ns, end_ns) at `pixels` (row-major, ascending).
+int64_t EventsAt(const EventStream& events, int64_t begin_ns, int64_t end_ns,
+                 const std::vector<int32_t>& pixels) {
+  if (pixels.empty()) return 0;
+  std::vector<uint8_t> at(static_cast<size_t>(events.width()) * events.height(), 0);
+  for (const int32_t p : pixels) at[static_cast<size_t>(p)] = 1;
+  int64_t count = 0;
+  const size_t end = events.LowerBound(end_ns);
+  for (size_t i = events.LowerBound(begin_ns); i < end; ++i) {
+    if (events.x(i) < events.width() && events.y(i) < events.height()) {
+      count += at[static_cast<size_t>(events.y(i)) * events.width() + events.x(i)];
+    }
+  }
+  return count;
+}
+
+// `pixels` without those in `taken` (both ascending).
+std::vector<int32_t> Untaken(const std::vector<int32_t>& pixels,
+                             const std::vector<int32_t>& taken) {
+  std::vector<int32_t> rest;
+  std::set_difference(pixels.begin(), pixels.end(), taken.begin(), taken.end(),
+                      std::back_inserter(rest));
+  return rest;
+}
+
+// PlanBinning; *binned receives the events it bins: `events`, or *kept when hot, saturated or
+// flickering pixels or unsupported events were left out.
 BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t end_ns,
-                          const BinningOptions& binning, EventStream* kept,
-                          const EventStream** binned) {
+                          const BinningOptions& binning, const std::vector<const Image*>& frames,
+                          EventStream* kept, const EventStream** binned) {
   std::string error;
   if (!binning.IsValid(&error)) throw InvalidArgumentError("binning: " + error);
   BinningPlan plan;
   plan.pixels = static_cast<int64_t>(events.width()) * events.height();
   plan.activity = MeasurePixelActivity(events, begin_ns, end_ns, binning.hot_pixel_factor);
+  // Each rule takes the pixels the rules before it left, so that every pixel left out is
+  // counted once.
+  std::vector<int32_t> left_out = plan.activity.hot_pixels;
+  plan.saturated_pixels = Untaken(
+      SaturatedPixels(frames, events.width(), events.height(), binning.saturation_level), left_out);
+  plan.saturated_pixel_events = EventsAt(events, begin_ns, end_ns, plan.saturated_pixels);
+  std::vector<int32_t> merged;
+  std::merge(left_out.begin(), left_out.end(), plan.saturated_pixels.begin(),
+             plan.saturated_pixels.end(), std::back_inserter(merged));
+  left_out.swap(merged);
+  plan.flickering_pixels = Untaken(
+      FindFlickeringPixels(events, begin_ns, end_ns, binning.flicker_min_reversals), left_out);
+  plan.flickering_pixel_events = EventsAt(events, begin_ns, end_ns, plan.flickering_pixels);
+  merged.clear();
+  std::merge(left_out.begin(), left_out.end(), plan.flickering_pixels.begin(),
+             plan.flickering_pixels.end(), std::back_inserter(merged));
+  left_out.swap(merged);
   *binned = &events;
-  if (!plan.activity.hot_pixels.empty()) {
-    *kept = WithoutPixels(events, plan.activity.hot_pixels);
+  if (!left_out.empty()) {
+    *kept = WithoutPixels(events, left_out);
     *binned = kept;
   }
   if (binning.noise_filter_ms > 0.0) {
@@ -116,6 +183,9 @@ bool BinningOptions::IsValid(std::string* error) const {
              "max_latent_frames and max_latent_voxels must be at least 1")
       .NonNegative("min_latent_steps", min_latent_steps)
       .NonNegative("hot_pixel_factor", hot_pixel_factor)
+      .Check(saturation_level > 0.0 && std::isfinite(saturation_level),
+             "saturation_level must be a positive level (above 1 keeps every event)")
+      .NonNegative("flicker_min_reversals", flicker_min_reversals)
       .Check(noise_filter_ms >= 0.0 && noise_filter_ms <= kMaxNoiseFilterMs,
              "noise_filter_ms must lie in [0, 3600000] (an hour)");
   if (method == Method::kStacked) check.Valid(stacked);
@@ -123,10 +193,10 @@ bool BinningOptions::IsValid(std::string* error) const {
 }
 
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
-                        const BinningOptions& binning) {
+                        const BinningOptions& binning, const std::vector<const Image*>& frames) {
   EventStream kept;
   const EventStream* binned = nullptr;
-  return PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept, &binned);
+  return PlanAndFilter(events, window_begin_ns, window_end_ns, binning, frames, &kept, &binned);
 }
 
 Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events,
@@ -146,10 +216,17 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
                                std::to_string(events.height()) + " but the frames are " +
                                std::to_string(scene.width) + "x" + std::to_string(scene.height));
   }
+  std::vector<const Image*> images;
+  for (const TimedFrame& frame : frames) {
+    if (frame.image.rows() != scene.height || frame.image.cols() != scene.width) {
+      throw InvalidArgumentError(frame.label + ": frame size differs from the scene's");
+    }
+    images.push_back(&frame.image);
+  }
   EventStream kept;
   const EventStream* binned = nullptr;
   const BinningPlan plan =
-      PlanAndFilter(events, window_begin_ns, window_end_ns, binning, &kept, &binned);
+      PlanAndFilter(events, window_begin_ns, window_end_ns, binning, images, &kept, &binned);
   scene.events =
       plan.method == BinningOptions::Method::kCollision
           ? BinByCollision(*binned, window_begin_ns, window_end_ns, plan.min_latent_steps)
@@ -158,6 +235,10 @@ Scene MakeScene(const std::vector<TimedFrame>& frames, const EventStream& events
   scene.hot_pixels = plan.activity.hot_pixels;
   scene.hot_pixel_events = plan.activity.hot_pixel_events;
   scene.noise_events = plan.noise_events;
+  scene.saturated_pixels = plan.saturated_pixels;
+  scene.saturated_pixel_events = plan.saturated_pixel_events;
+  scene.flickering_pixels = plan.flickering_pixels;
+  scene.flickering_pixel_events = plan.flickering_pixel_events;
 
   const std::vector<int64_t>& latent_ns = scene.latent_timestamps_ns();
   for (const TimedFrame& frame : frames) {

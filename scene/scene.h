@@ -66,6 +66,16 @@ struct BinningOptions {
   /// stuck pixel neither multiplies the collision frames nor bends its own pixel; 0 keeps every
   /// event. 10 is more than twice the largest ratio in the shared DAVIS recordings (4.4).
   double hot_pixel_factor = 10.0;
+  /// Every method: a pixel at or above this level (intensity in [0, 1]) in any frame of the
+  /// window is saturated, and its events are left out. A saturated frame pixel cannot show the
+  /// changes its events record (a lamp or an LED brighter than the frame's full scale still
+  /// fires events), so the frames govern there; > 1 keeps every event. The default takes the
+  /// top two codes of an 8-bit frame.
+  double saturation_level = 0.995;
+  /// Every method: pixels whose events reverse polarity at least this many times in the window
+  /// with almost no net change flicker (FindFlickeringPixels: a blinking LED or a mains-powered
+  /// lamp), and their events are left out, so the frames govern there; 0 keeps them.
+  int flicker_min_reversals = 3;
   /// Every method: after the hot pixels, events that no neighbouring pixel confirms within this
   /// many milliseconds are left out as background activity (WithoutUnsupportedEvents); 0 keeps
   /// them.
@@ -93,16 +103,26 @@ struct BinningPlan {
   int64_t min_latent_steps = 0;  // kCollision: BinByCollision's split (0: none)
   PixelActivity activity;        // hot pixels and counts, before leaving any out
   int64_t noise_events = 0;      // left out by the background-activity filter
+  /// Pixels (row-major, ascending) whose events were left out, besides the hot ones, because
+  /// a frame saturates there (saturation_level) or the pixel flickers (flicker_min_reversals),
+  /// and how many events each rule left out. A pixel counts under the first rule that takes it.
+  std::vector<int32_t> saturated_pixels;
+  int64_t saturated_pixel_events = 0;
+  std::vector<int32_t> flickering_pixels;
+  int64_t flickering_pixel_events = 0;
 
   int64_t latent_voxels() const { return pixels * num_latent_frames; }
 };
 
-/// Decides the binning of the events in [window_begin_ns, window_end_ns) from counts. Throws
-/// InvalidArgumentError, naming the option to change, when the binning asked for would exceed
-/// binning.max_latent_voxels (explicit collision or stacked binning over it, or a sensor on
-/// which not even one latent step fits), for invalid options, or as the binning functions do.
+/// Decides the binning of the events in [window_begin_ns, window_end_ns) from counts, after
+/// leaving out the events of hot, saturated (in any of `frames`, which may be empty) and
+/// flickering pixels. Throws InvalidArgumentError, naming the option to change, when the binning
+/// asked for would exceed binning.max_latent_voxels (explicit collision or stacked binning over
+/// it, or a sensor on which not even one latent step fits), for invalid options, for a frame of
+/// another size than the sensor, or as the binning functions do.
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
-                        const BinningOptions& binning);
+                        const BinningOptions& binning,
+                        const std::vector<const Image*>& frames = {});
 
 struct Scene {
   int height = 0;
@@ -116,6 +136,12 @@ struct Scene {
   int64_t hot_pixel_events = 0;
   /// Events left out by the background-activity filter (BinningOptions::noise_filter_ms).
   int64_t noise_events = 0;
+  /// Pixels whose events were left out because a frame saturates there or they flicker
+  /// (BinningPlan), and how many events each rule left out.
+  std::vector<int32_t> saturated_pixels;
+  int64_t saturated_pixel_events = 0;
+  std::vector<int32_t> flickering_pixels;
+  int64_t flickering_pixel_events = 0;
 
   int num_latent_frames() const { return static_cast<int>(events.latent_timestamps_ns().size()); }
   const std::vector<int64_t>& latent_timestamps_ns() const { return events.latent_timestamps_ns(); }

@@ -107,6 +107,31 @@ TEST(PlanVideoWindowsTest, FramesWithExposuresAreObservedOverThem) {
   windows = PlanVideoWindows(frames, true, 0, options);
   EXPECT_FALSE(windows[0].frames[0].blurred);
   EXPECT_EQ(windows[0].begin_ns, frames[0].t_ns);
+
+  // A frame the data showed unblurred (sharp_frames) is observed at its timestamp; the others
+  // keep their exposures, and BlurCandidateExposure still names every exposure.
+  options.min_blur_exposure_s = 0.0;
+  options.sharp_frames = {1};
+  windows = PlanVideoWindows(frames, true, 0, options);
+  EXPECT_TRUE(windows[0].frames[0].blurred);
+  EXPECT_FALSE(windows[0].frames[1].blurred);
+  EXPECT_FALSE(windows[1].frames[0].blurred);
+  EXPECT_EQ(windows[0].end_ns, frames[1].t_ns);
+  int64_t begin_ns = 0, end_ns = 0;
+  EXPECT_TRUE(BlurCandidateExposure(frames[1], options, &begin_ns, &end_ns));
+  EXPECT_EQ(begin_ns, frames[1].t_ns - 10 * kMs);
+  EXPECT_EQ(end_ns, frames[1].t_ns + 10 * kMs);
+  EXPECT_FALSE(BlurCandidateExposure(Frames(1)[0], options, &begin_ns, &end_ns));
+}
+
+TEST(PlanVideoWindowsTest, SelectedFramesAreEveryStepFromFirstLessTheExcluded) {
+  VideoWindowOptions options;
+  options.first = 1;
+  options.frame_step = 2;
+  options.excluded_frames = {5};
+  EXPECT_EQ(SelectedFrames(9, options), std::vector<int>({1, 3, 7}));
+  options.last = 4;
+  EXPECT_EQ(SelectedFrames(9, options), std::vector<int>({1, 3}));
 }
 
 TEST(PlanVideoWindowsTest, ALoneBlurredFrameIsOneDeblurWindow) {

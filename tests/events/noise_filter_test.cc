@@ -84,5 +84,44 @@ TEST(NoiseFilter, SeparatesAMovingEdgeFromBackgroundActivity) {
   EXPECT_LT(noise_kept, noise / 4) << noise_kept << " of " << noise;
 }
 
+// A pixel under a light blinking at 500 Hz fires bursts of alternating sign; an edge crossing
+// another pixel fires one run of one sign and a bar crossing a third fires one run of each.
+TEST(FlickeringPixels, FindsAlternatingBurstsWithNoNetChange) {
+  constexpr int kWidth = 6, kHeight = 4;
+  EventStream events(kWidth, kHeight);
+  const int32_t led = 1 * kWidth + 2;  // the edge is at (4, 2), the bar at (0, 3)
+  for (int period = 0; period < 10; ++period) {
+    const int64_t t = period * 2 * kMs;
+    events.push_back(t, 2, 1, 1);
+    events.push_back(t + kMs / 10, 2, 1, 1);
+    events.push_back(t + kMs, 2, 1, -1);
+    events.push_back(t + kMs + kMs / 10, 2, 1, -1);
+    if (period < 4) events.push_back(t + kMs / 2, 4, 2, 1);
+    if (period == 2) events.push_back(t + kMs / 3, 0, 3, 1);
+    if (period == 3) events.push_back(t + kMs / 3, 0, 3, -1);
+  }
+  int64_t at = -1;
+  const std::vector<int32_t> found = FindFlickeringPixels(events, 0, 20 * kMs, 3, &at);
+  ASSERT_EQ(found, std::vector<int32_t>({led}));
+  EXPECT_EQ(at, 40);
+  // Within a window holding two periods the LED reverses 3 times: still flickering at 3.
+  EXPECT_EQ(FindFlickeringPixels(events, 0, 4 * kMs, 3), std::vector<int32_t>({led}));
+  EXPECT_TRUE(FindFlickeringPixels(events, 0, 4 * kMs, 4).empty());
+  EXPECT_TRUE(FindFlickeringPixels(events, 0, 20 * kMs, 0).empty());
+}
+
+// Alternating events that add up to a large net change are the scene, not a light: a texture
+// crossing the pixel while it brightens overall.
+TEST(FlickeringPixels, KeepsPixelsWhoseEventsAddUpToAChange) {
+  EventStream events(2, 2);
+  int64_t t = 0;
+  for (int run = 0; run < 4; ++run) {
+    for (int k = 0; k < 4; ++k) events.push_back(t += kMs, 0, 0, 1);
+    events.push_back(t += kMs, 0, 0, -1);
+  }
+  // 16 ON, 4 OFF: |net| 12 is more than a quarter of 20 events, though it reversed 7 times.
+  EXPECT_TRUE(FindFlickeringPixels(events, 0, t + 1, 3).empty());
+}
+
 }  // namespace
 }  // namespace evfs

@@ -90,10 +90,12 @@ TEST(EvfsLimits, HotPixelIsLeftOutAndReported) {
   EXPECT_NE(summary.find("\"hot_pixels\": 1,"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"hot_pixel_events\": 1000,"), std::string::npos) << summary;
 
-  // --hot_pixel_factor=0 keeps every event: a thousand collision frames, so auto binning falls
-  // back to --max_latent_frames stacked frames, decided from counts.
-  const CommandResult kept =
-      RunLimited("info --data=" + data + " --first=0 --last=4 --hot_pixel_factor=0");
+  // --hot_pixel_factor=0 keeps every event (and --flicker_min_reversals=0, since the hot pixel
+  // alternates in sign): a thousand collision frames, so auto binning falls back to
+  // --max_latent_frames stacked frames, decided from counts.
+  const CommandResult kept = RunLimited("info --data=" + data +
+                                        " --first=0 --last=4 --hot_pixel_factor=0 "
+                                        "--flicker_min_reversals=0");
   ASSERT_EQ(kept.exit_code, 0) << kept.output;
   EXPECT_NE(kept.output.find("binning     auto: stacked, 48 event frames, 49 latent frames"),
             std::string::npos)

@@ -243,6 +243,7 @@ TEST(Scene, HotPixelDoesNotMultiplyTheLatentSteps) {
   // Without the rule the hot pixel decides the timeline: the fallback to max_latent_frames.
   BinningOptions keep_all;
   keep_all.hot_pixel_factor = 0.0;
+  keep_all.flicker_min_reversals = 0;  // the hot pixel alternates: the flicker rule takes it
   const Scene kept = MakePredictionScene(recording.Sharp(0), end_ns, hot, keep_all);
   EXPECT_TRUE(kept.hot_pixels.empty());
   EXPECT_EQ(kept.num_latent_frames(), keep_all.max_latent_frames + 1);
@@ -297,6 +298,86 @@ TEST(Scene, NoiseFilterLeavesOutIsolatedEventsBeforeBinning) {
   EXPECT_NE(error.find("noise_filter_ms"), std::string::npos) << error;
 }
 
+// Events at (x, y) of `events` in [begin_ns, end_ns).
+int64_t EventsAtPixel(const EventStream& events, int x, int y, int64_t begin_ns, int64_t end_ns) {
+  int64_t count = 0;
+  for (size_t i = 0; i < events.size(); ++i) {
+    count += events.x(i) == x && events.y(i) == y && events.t_ns(i) >= begin_ns &&
+             events.t_ns(i) < end_ns;
+  }
+  return count;
+}
+
+// The busiest pixel of `events`: one where the moving shapes fire.
+std::pair<int, int> BusiestPixel(const EventStream& events) {
+  std::vector<int> count(static_cast<size_t>(events.width()) * events.height(), 0);
+  for (size_t i = 0; i < events.size(); ++i) ++count[events.y(i) * events.width() + events.x(i)];
+  const int p = static_cast<int>(std::max_element(count.begin(), count.end()) - count.begin());
+  return {p % events.width(), p / events.width()};
+}
+
+// A frame pixel at full scale cannot show what its events record: they are left out and
+// counted, and with a level above 1 they are kept.
+TEST(Scene, SaturatedPixelLeavesItsEventsToTheFrames) {
+  const test::SyntheticRecording recording;
+  const int64_t begin_ns = recording.rendered.timestamp_ns(0);
+  const int64_t end_ns = recording.rendered.timestamp_ns(20);
+  const auto [x, y] = BusiestPixel(recording.events);
+  const int64_t at_pixel = EventsAtPixel(recording.events, x, y, begin_ns, end_ns);
+  ASSERT_GT(at_pixel, 0);
+  TimedFrame last = recording.Sharp(20);
+  last.image(y, x) = 1.0;
+  const Scene clean = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                             recording.events, BinningOptions());
+  const Scene scene =
+      MakeInterpolationScene(recording.Sharp(0), last, recording.events, BinningOptions());
+  EXPECT_TRUE(clean.saturated_pixels.empty());
+  ASSERT_EQ(scene.saturated_pixels.size(), 1u);
+  EXPECT_EQ(scene.saturated_pixels[0], y * recording.events.width() + x);
+  EXPECT_EQ(scene.saturated_pixel_events, at_pixel);
+  EXPECT_EQ(scene.num_events + at_pixel, clean.num_events);
+  double fired = 0.0;
+  for (int k = 0; k < scene.events.num_frames(); ++k)
+    fired += std::abs(scene.events.value(k, y, x));
+  EXPECT_EQ(fired, 0.0);
+
+  BinningOptions keep;
+  keep.saturation_level = 1.5;
+  const Scene kept = MakeInterpolationScene(recording.Sharp(0), last, recording.events, keep);
+  EXPECT_TRUE(kept.saturated_pixels.empty());
+  EXPECT_EQ(kept.num_events, clean.num_events);
+
+  BinningOptions invalid;
+  invalid.saturation_level = 0.0;
+  std::string error;
+  EXPECT_FALSE(invalid.IsValid(&error));
+  EXPECT_NE(error.find("saturation_level"), std::string::npos) << error;
+}
+
+// A light blinking at one pixel (alternating bursts, far fewer events than a hot pixel's) is
+// left to the frames; the moving shapes' own pixels are not taken for flicker.
+TEST(Scene, FlickeringPixelLeavesItsEventsToTheFrames) {
+  const test::SyntheticRecording recording;
+  const int64_t begin_ns = recording.rendered.timestamp_ns(0);
+  const int64_t end_ns = recording.rendered.timestamp_ns(20);
+  const int x = 1, y = 1;
+  const int64_t own = EventsAtPixel(recording.events, x, y, begin_ns, end_ns);
+  const EventStream lit = WithHotPixel(recording.events, x, y, 12, begin_ns, end_ns);
+  const Scene clean =
+      MakePredictionScene(recording.Sharp(0), end_ns, recording.events, BinningOptions());
+  EXPECT_TRUE(clean.flickering_pixels.empty());
+  const Scene scene = MakePredictionScene(recording.Sharp(0), end_ns, lit, BinningOptions());
+  EXPECT_TRUE(scene.hot_pixels.empty());
+  ASSERT_EQ(scene.flickering_pixels.size(), 1u);
+  EXPECT_EQ(scene.flickering_pixels[0], y * lit.width() + x);
+  EXPECT_EQ(scene.flickering_pixel_events, own + 12);
+  EXPECT_EQ(scene.num_events + own + 12, clean.num_events + 12);
+
+  BinningOptions keep;
+  keep.flicker_min_reversals = 0;
+  EXPECT_TRUE(MakePredictionScene(recording.Sharp(0), end_ns, lit, keep).flickering_pixels.empty());
+}
+
 #if !defined(__SANITIZE_ADDRESS__) && !EVFS_HAS_FEATURE(address_sanitizer) && \
     !EVFS_HAS_FEATURE(memory_sanitizer) && !defined(__SANITIZE_THREAD__)
 // Regression (issue 14): the binning allocated collision frames × pixels before the voxel cap
@@ -316,7 +397,9 @@ TEST(Scene, MemoryIsBoundedBeforeAllocating) {
       TimedFrame first;
       first.image = Image::Zero(kSide, kSide);
       first.label = "zeros";
-      const Scene scene = MakePredictionScene(first, 2000, events, BinningOptions());
+      BinningOptions binning;
+      binning.flicker_min_reversals = 0;  // the pixel alternates: keep its events for the test
+      const Scene scene = MakePredictionScene(first, 2000, events, binning);
       // 12 M voxels hold 2 latent frames of 4 M pixels: one stacked step.
       status = scene.num_latent_frames() == 2 && scene.num_events == 300 ? 0 : 2;
     } catch (const std::bad_alloc&) {

@@ -1,0 +1,195 @@
+#include "scene/confidence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "core/error.h"
+#include "core/option_checker.h"
+#include "scene/exposure_blur.h"
+
+namespace evfs {
+namespace {
+
+// An observed frame where the latent video is pinned: a sharp frame at its latent frame, or a
+// blurred one at the middle of its exposure.
+struct Anchor {
+  int latent = 0;
+  const Image* image = nullptr;
+  bool sharp = true;
+};
+
+// The mean of `values` (rows × cols) over the (2 radius + 1)² square around each pixel, the
+// border reflected.
+std::vector<float> BoxMean(const std::vector<float>& values, int rows, int cols, int radius) {
+  std::vector<float> mean(values.size());
+  const cv::Mat in(rows, cols, CV_32F, const_cast<float*>(values.data()));
+  cv::Mat out(rows, cols, CV_32F, mean.data());
+  const int size = 2 * radius + 1;
+  cv::blur(in, out, cv::Size(size, size), cv::Point(-1, -1), cv::BORDER_REFLECT);
+  return mean;
+}
+
+}  // namespace
+
+bool ConfidenceOptions::IsValid(std::string* error) const {
+  OptionChecker check;
+  check
+      .Check(std::isfinite(change_per_event) && change_per_event > 0.0,
+             "change_per_event must be positive")
+      .Check(std::isfinite(off_change_ratio) && off_change_ratio > 0.0,
+             "off_change_ratio must be positive")
+      .Check(std::isfinite(log_offset) && log_offset > 0.0, "log_offset must be positive")
+      .Check(std::isfinite(prior_event_variance), "prior_event_variance must be finite")
+      .InRange("pool_radius_px", pool_radius_px, 0, 1000);
+  return check.Passed(error);
+}
+
+Video PredictErrorSigma(const Scene& scene, const Video& latent, const ConfidenceOptions& options,
+                        ConfidenceModel* model) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("confidence: " + error);
+  const int frames = latent.num_frames();
+  if (latent.height() != scene.height || latent.width() != scene.width ||
+      frames != scene.num_latent_frames()) {
+    throw InvalidArgumentError("confidence: the latent video does not match the scene's timeline");
+  }
+  const int rows = scene.height, cols = scene.width;
+  const size_t pixels = static_cast<size_t>(rows) * cols;
+
+  // G(t) and n(t) per pixel: the change of g the events record up to latent frame t, and how
+  // many events that took. An event frame spread over several latent steps adds evenly to each.
+  std::vector<float> g(static_cast<size_t>(frames) * pixels, 0.0f);
+  std::vector<float> n(g.size(), 0.0f);
+  const double on = options.change_per_event, off = on * options.off_change_ratio;
+  for (int k = 0; k < scene.events.num_frames(); ++k) {
+    const EventFrameSpan& span = scene.events.span(k);
+    const int steps = span.latent_last - span.latent_first;
+    if (steps <= 0) continue;
+    const float* values = scene.events.frame_data(k);
+    for (size_t p = 0; p < pixels; ++p) {
+      const double value = values[p];
+      if (value == 0.0) continue;
+      const double change = value * (value > 0.0 ? on : off) / steps;
+      const double count = std::abs(value) / steps;
+      for (int s = span.latent_first + 1; s <= span.latent_last; ++s) {
+        g[static_cast<size_t>(s) * pixels + p] += static_cast<float>(change);
+        n[static_cast<size_t>(s) * pixels + p] += static_cast<float>(count);
+      }
+    }
+  }
+  for (int t = 1; t < frames; ++t) {
+    for (size_t p = 0; p < pixels; ++p) {
+      g[static_cast<size_t>(t) * pixels + p] += g[static_cast<size_t>(t - 1) * pixels + p];
+      n[static_cast<size_t>(t) * pixels + p] += n[static_cast<size_t>(t - 1) * pixels + p];
+    }
+  }
+  const auto at = [pixels](const std::vector<float>& v, int t, size_t p) {
+    return static_cast<double>(v[static_cast<size_t>(t) * pixels + p]);
+  };
+
+  std::vector<Anchor> anchors;
+  double noise = 0.0;
+  for (const FrameObservation& frame : scene.frames) {
+    anchors.push_back({(frame.latent_first + frame.latent_last) / 2, &frame.image,
+                       frame.latent_first == frame.latent_last});
+    noise += NoiseSigma(frame.image);
+  }
+  if (!anchors.empty()) noise /= static_cast<double>(anchors.size());
+  std::stable_sort(anchors.begin(), anchors.end(),
+                   [](const Anchor& a, const Anchor& b) { return a.latent < b.latent; });
+
+  // The gap D between each pair of neighbouring sharp frames, pooled locally.
+  const double b = options.log_offset;
+  std::vector<std::vector<float>> pooled_gap(anchors.size());  // [i]: between anchors i, i + 1
+  double sum_gap2 = 0.0, sum_events = 0.0;
+  for (size_t i = 0; i + 1 < anchors.size(); ++i) {
+    const Anchor& first = anchors[i];
+    const Anchor& second = anchors[i + 1];
+    if (!first.sharp || !second.sharp || second.latent <= first.latent) continue;
+    std::vector<float> gap2(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+      const double change = at(g, second.latent, p) - at(g, first.latent, p);
+      const double predicted = (first.image->data()[p] + b) * std::exp(change) - b;
+      const double gap = second.image->data()[p] - predicted;
+      gap2[p] = static_cast<float>(gap * gap);
+      sum_gap2 += gap * gap;
+      sum_events += at(n, second.latent, p) - at(n, first.latent, p) + 1.0;
+    }
+    pooled_gap[i] = BoxMean(gap2, rows, cols, options.pool_radius_px);
+  }
+  const double measured = sum_events > 0.0 ? sum_gap2 / sum_events : -1.0;
+  const double per_event = measured >= 0.0 ? measured : options.prior_event_variance;
+
+  Video sigma(rows, cols, frames);
+  for (int t = 0; t < frames; ++t) {
+    sigma.set_timestamp_ns(t, latent.timestamp_ns(t));
+    // The anchors around t: the last at or before it and the first after it.
+    int before = -1, after = -1;
+    for (size_t i = 0; i < anchors.size(); ++i) {
+      if (anchors[i].latent <= t) before = static_cast<int>(i);
+      if (anchors[i].latent > t && after < 0) after = static_cast<int>(i);
+    }
+    const bool bridge = before >= 0 && after == before + 1 && !pooled_gap[before].empty();
+    double* out = sigma.frame_data(t);
+    const double* estimate = latent.frame_data(t);
+    for (size_t p = 0; p < pixels; ++p) {
+      double variance = 0.0;
+      if (bridge) {
+        const int a = anchors[before].latent, z = anchors[after].latent;
+        const double events = at(n, z, p) - at(n, a, p);
+        const double s = events > 0.0 ? (at(n, t, p) - at(n, a, p)) / events
+                                      : static_cast<double>(t - a) / (z - a);
+        variance = pooled_gap[before][p] * s * (1.0 - s) +
+                   noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
+      } else {
+        const int nearest = before < 0  ? anchors[after].latent
+                            : after < 0 ? anchors[before].latent
+                                        : (t - anchors[before].latent <= anchors[after].latent - t
+                                               ? anchors[before].latent
+                                               : anchors[after].latent);
+        const double events = std::abs(at(n, t, p) - at(n, nearest, p));
+        const double one_event = (std::max(estimate[p], 0.0) + b) * on;
+        const double v = per_event >= 0.0 ? per_event : one_event * one_event;
+        variance = v * events + 2.0 * noise * noise;
+      }
+      out[p] = std::sqrt(variance);
+    }
+  }
+  if (model != nullptr) {
+    model->frame_noise_sigma = noise;
+    model->measured_event_variance = measured;
+    char line[200];
+    if (measured >= 0.0) {
+      std::snprintf(line, sizeof(line),
+                    "frame noise %.4f; one event's error %.4f (measured between the sharp frames)",
+                    noise, std::sqrt(measured));
+    } else if (options.prior_event_variance >= 0.0) {
+      std::snprintf(line, sizeof(line), "frame noise %.4f; one event's error %.4f (prior)", noise,
+                    std::sqrt(options.prior_event_variance));
+    } else {
+      std::snprintf(line, sizeof(line),
+                    "frame noise %.4f; one event's error: its own change (nothing measured it)",
+                    noise);
+    }
+    model->description = line;
+  }
+  return sigma;
+}
+
+double ShareWithinSigma(const Image& estimate, const Image& truth, const Image& sigma) {
+  if (estimate.size() == 0 || estimate.rows() != truth.rows() || estimate.cols() != truth.cols() ||
+      sigma.rows() != truth.rows() || sigma.cols() != truth.cols()) {
+    throw InvalidArgumentError("ShareWithinSigma: the images must be non-empty and of one size");
+  }
+  int64_t within = 0;
+  for (int64_t p = 0; p < estimate.size(); ++p) {
+    within += std::abs(estimate.data()[p] - truth.data()[p]) <= sigma.data()[p];
+  }
+  return static_cast<double>(within) / static_cast<double>(estimate.size());
+}
+
+}  // namespace evfs
