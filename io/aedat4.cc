@@ -47,6 +47,8 @@ constexpr size_t kSizePrefixBytes = 4;
 constexpr size_t kPacketHeaderBytes = 8;
 // The smallest flatbuffer: a root offset and a table's vtable offset.
 constexpr size_t kMinFlatbufferBytes = 8;
+// The largest alignment of a field in the AEDAT 4 schemas (int64, and the Event struct).
+constexpr size_t kFlatbufferAlignment = 8;
 // Most bytes a packet body (or the data table) may decompress to: 16 M events, or a 8192x8192
 // BGRA frame. DV writes packets of a few milliseconds (~100 KB), so a larger claim is a corrupt
 // file or a decompression bomb; refusing it bounds what one packet can make evfs allocate.
@@ -264,6 +266,35 @@ flatbuffers::Verifier::Options VerifierOptions(size_t bytes) {
   return options;
 }
 
+// Verifies the size-prefixed flatbuffer in *buffer, whose prefix the caller has checked against
+// its length, as a `Table` with file identifier `identifier`; returns its root, or nullptr when
+// it is not one. *buffer must start at an address aligned for kFlatbufferAlignment (a vector's
+// allocation is).
+//
+// A flatbuffer builder writes from the end backwards and aligns every field relative to the end,
+// padding the front so that the finished buffer is a whole number of its largest alignment. DV
+// counts the size prefix in that whole (FlatBufferBuilder::FinishSizePrefixed); other writers
+// finish the flatbuffer alone and then put its size in front, so that their fields lie 4 bytes
+// off DV's relative to the prefix. The verifier checks alignment from the first byte it is given
+// (and flatbuffers reads fields in place), so it is given bytes that span a whole number of
+// kFlatbufferAlignment from an aligned address: the prefix and the flatbuffer when they do (DV's
+// layout), else the flatbuffer alone, moved to the start of *buffer. Bytes no builder wrote (a
+// length not a multiple of 4) are verified as DV's layout and refused where a field is
+// misaligned.
+template <typename Table>
+const Table* VerifiedSizePrefixedRoot(std::vector<uint8_t>* buffer, const char* identifier) {
+  if ((buffer->size() - kSizePrefixBytes) % kFlatbufferAlignment == 0) {
+    buffer->erase(buffer->begin(), buffer->begin() + kSizePrefixBytes);
+    flatbuffers::Verifier verifier(buffer->data(), buffer->size(), VerifierOptions(buffer->size()));
+    return verifier.VerifyBuffer<Table>(identifier) ? flatbuffers::GetRoot<Table>(buffer->data())
+                                                    : nullptr;
+  }
+  flatbuffers::Verifier verifier(buffer->data(), buffer->size(), VerifierOptions(buffer->size()));
+  return verifier.VerifySizePrefixedBuffer<Table>(identifier)
+             ? flatbuffers::GetSizePrefixedRoot<Table>(buffer->data())
+             : nullptr;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The stream description (IOHeader.info_node).
 
@@ -321,12 +352,12 @@ class HeaderParser {
     }
     // Copied: flatbuffers reads scalars in place, so the buffer must be aligned.
     const uint8_t* start = data_ + kVersionLineBytes;
-    const std::vector<uint8_t> buffer(start, start + kSizePrefixBytes + header_bytes);
-    flatbuffers::Verifier verifier(buffer.data(), buffer.size(), VerifierOptions(buffer.size()));
-    if (!fb::VerifySizePrefixedIOHeaderBuffer(verifier)) {
+    std::vector<uint8_t> buffer(start, start + kSizePrefixBytes + header_bytes);
+    const fb::IOHeader* io_header =
+        VerifiedSizePrefixedRoot<fb::IOHeader>(&buffer, fb::IOHeaderIdentifier());
+    if (io_header == nullptr) {
       Fail(InputError::Kind::kMalformed, "the IOHeader is not a valid IOHE flatbuffer (corrupt?)");
     }
-    const fb::IOHeader* io_header = fb::GetSizePrefixedIOHeader(buffer.data());
     Header header;
     header.data_start = kVersionLineBytes + kSizePrefixBytes + header_bytes;
     const int compression = static_cast<int>(io_header->compression());
@@ -531,11 +562,8 @@ class Aedat4DataSource::File {
         header_.data_table_position >= 0 ? static_cast<size_t>(header_.data_table_position) : size_;
     // The sensor size first: indexing without a data table checks the events against it.
     SetSensorSizeFromDescription();
-    if (header_.data_table_position >= 0) {
-      IndexFromDataTable();
-    } else {
-      IndexByScanning();
-    }
+    indexed_by_data_table_ = header_.data_table_position >= 0 && IndexFromDataTable();
+    if (!indexed_by_data_table_) IndexByScanning();
     if (width_ == 0) SetSensorSizeFromFirstFrame();
     ReadFrameInfos();
   }
@@ -546,7 +574,7 @@ class Aedat4DataSource::File {
   std::vector<FrameInfo>& frames() { return frames_; }
   const Header& header() const { return header_; }
   bool has_events() const { return header_.events.id >= 0; }
-  bool indexed_by_data_table() const { return header_.data_table_position >= 0; }
+  bool indexed_by_data_table() const { return indexed_by_data_table_; }
   int num_event_packets() const { return static_cast<int>(event_packets_.size()); }
   int64_t packets_decoded() const { return packets_decoded_; }
 
@@ -604,13 +632,18 @@ class Aedat4DataSource::File {
            std::to_string(packet.offset - kPacketHeaderBytes);
   }
 
-  // Decompresses `packet` into buffer_ and checks it is a size-prefixed flatbuffer.
-  const std::vector<uint8_t>& ReadBody(const Packet& packet, const char* type) const {
-    return ReadFlatbuffer(data_ + packet.offset, packet.size, PacketName(packet, type));
+  // Decompresses `packet` of stream `type` into buffer_ and verifies it as a `Table`
+  // flatbuffer with file identifier `identifier`; returns its root (valid until the next read).
+  template <typename Table>
+  const Table* ReadPacket(const Packet& packet, const char* type, const char* identifier) const {
+    return ReadFlatbuffer<Table>(data_ + packet.offset, packet.size, PacketName(packet, type),
+                                 identifier);
   }
 
-  const std::vector<uint8_t>& ReadFlatbuffer(const uint8_t* data, size_t size,
-                                             const std::string& what) const {
+  // The same for the `size` compressed bytes at `data`, named `what` in messages.
+  template <typename Table>
+  const Table* ReadFlatbuffer(const uint8_t* data, size_t size, const std::string& what,
+                              const char* identifier) const {
     ++packets_decoded_;
     const std::string problem = decompressor_.Decompress(header_.compression, data, size, &buffer_);
     if (!problem.empty()) Fail(InputError::Kind::kMalformed, what + ": " + problem);
@@ -620,18 +653,18 @@ class Aedat4DataSource::File {
            what + ": " + std::to_string(buffer_.size()) +
                " bytes that are not a size-prefixed flatbuffer (corrupt?)");
     }
-    return buffer_;
+    const Table* root = VerifiedSizePrefixedRoot<Table>(&buffer_, identifier);
+    if (root == nullptr) {
+      Fail(InputError::Kind::kMalformed,
+           what + ": not a valid " + identifier + " flatbuffer (corrupt?)");
+    }
+    return root;
   }
 
   template <typename Visitor>
   void DecodeEvents(const Packet& packet, int64_t* previous_t_ns, Visitor&& visit) const {
-    const std::vector<uint8_t>& body = ReadBody(packet, kEventsType);
-    flatbuffers::Verifier verifier(body.data(), body.size(), VerifierOptions(body.size()));
-    if (!fb::VerifySizePrefixedEventPacketBuffer(verifier)) {
-      Fail(InputError::Kind::kMalformed,
-           PacketName(packet, kEventsType) + ": not a valid EVTS flatbuffer (corrupt?)");
-    }
-    const auto* elements = fb::GetSizePrefixedEventPacket(body.data())->elements();
+    const auto* elements =
+        ReadPacket<fb::EventPacket>(packet, kEventsType, fb::EventPacketIdentifier())->elements();
     // The verifier checks a vector's length field for 4-byte alignment only; the events in it
     // are read as 8-byte aligned structs (the aedat4 fuzzer found a vector 4 bytes off). The
     // buffer itself is allocated aligned, so the address says it.
@@ -679,13 +712,8 @@ class Aedat4DataSource::File {
 
   // Decodes the frame in `packet`: its times into *info and, when `image` is given, its pixels.
   void DecodeFrame(const Packet& packet, FrameInfo* info, Image* image) const {
-    const std::vector<uint8_t>& body = ReadBody(packet, kFramesType);
+    const fb::Frame* frame = ReadPacket<fb::Frame>(packet, kFramesType, fb::FrameIdentifier());
     const std::string name = PacketName(packet, kFramesType);
-    flatbuffers::Verifier verifier(body.data(), body.size(), VerifierOptions(body.size()));
-    if (!fb::VerifySizePrefixedFrameBuffer(verifier)) {
-      Fail(InputError::Kind::kMalformed, name + ": not a valid FRME flatbuffer (corrupt?)");
-    }
-    const fb::Frame* frame = fb::GetSizePrefixedFrame(body.data());
     if (info != nullptr) {
       const auto to_ns = [&](int64_t t_us, const char* what) {
         if (t_us > kMaxMicroseconds || t_us < -kMaxMicroseconds) {
@@ -775,16 +803,16 @@ class Aedat4DataSource::File {
     }
   }
 
-  void IndexFromDataTable() {
+  // Indexes the packets from the data table; false (indexing nothing) when the table does not
+  // give the element count of every event packet. A count of 0 says nothing: DV writes no empty
+  // packets, and tools that cut or rewrite recordings write tables of offsets alone, without
+  // counts and times, which other readers, walking the packets, never look at.
+  bool IndexFromDataTable() {
     const size_t position = static_cast<size_t>(header_.data_table_position);
-    const std::vector<uint8_t>& body =
-        ReadFlatbuffer(data_ + position, size_ - position, "the file data table");
-    flatbuffers::Verifier verifier(body.data(), body.size(), VerifierOptions(body.size()));
-    if (!fb::VerifySizePrefixedFileDataTableBuffer(verifier)) {
-      Fail(InputError::Kind::kMalformed,
-           "the file data table is not a valid FTAB flatbuffer (corrupt?)");
-    }
-    const auto* table = fb::GetSizePrefixedFileDataTable(body.data())->table();
+    const auto* table =
+        ReadFlatbuffer<fb::FileDataTable>(data_ + position, size_ - position,
+                                          "the file data table", fb::FileDataTableIdentifier())
+            ->table();
     const size_t entries = table != nullptr ? table->size() : 0;
     for (size_t i = 0; i < entries; ++i) {
       const fb::FileDataDefinition* entry = table->Get(static_cast<flatbuffers::uoffset_t>(i));
@@ -804,7 +832,11 @@ class Aedat4DataSource::File {
         continue;
       }
       packet.count = entry->num_elements();
-      if (packet.count == 0) continue;  // nothing to read
+      if (packet.count == 0) {
+        event_packets_.clear();
+        frame_packets_.clear();
+        return false;
+      }
       const std::string where = "file data table entry " + std::to_string(i) + ": ";
       if (packet.count < 0 || packet.count > static_cast<int64_t>(kMaxPacketBytes / kEventBytes)) {
         Fail(InputError::Kind::kMalformed,
@@ -830,19 +862,21 @@ class Aedat4DataSource::File {
       }
       event_packets_.push_back(packet);
     }
+    return true;
   }
 
+  // Indexes the packets by a pass over them, up to the data table (or the end of the file).
   void IndexByScanning() {
     int64_t previous_t_ns = std::numeric_limits<int64_t>::min();
     size_t offset = header_.data_start;
-    while (offset < size_) {
-      if (size_ - offset < kPacketHeaderBytes) {
+    while (offset < data_end_) {
+      if (data_end_ - offset < kPacketHeaderBytes) {
         Fail(InputError::Kind::kMalformed,
              "truncated packet header at byte " + std::to_string(offset) + " (truncated file?)");
       }
       const int32_t stream = ReadI32(data_ + offset);
       const int32_t size = ReadI32(data_ + offset + 4);
-      const size_t remaining = size_ - offset - kPacketHeaderBytes;
+      const size_t remaining = data_end_ - offset - kPacketHeaderBytes;
       if (size < 0 || static_cast<size_t>(size) > remaining) {
         Fail(InputError::Kind::kMalformed,
              "the packet at byte " + std::to_string(offset) + " (stream " + std::to_string(stream) +
@@ -891,13 +925,8 @@ class Aedat4DataSource::File {
 
   void SetSensorSizeFromFirstFrame() {
     if (!frame_packets_.empty()) {
-      const std::vector<uint8_t>& body = ReadBody(frame_packets_.front(), kFramesType);
-      flatbuffers::Verifier verifier(body.data(), body.size(), VerifierOptions(body.size()));
-      if (!fb::VerifySizePrefixedFrameBuffer(verifier)) {
-        Fail(InputError::Kind::kMalformed, PacketName(frame_packets_.front(), kFramesType) +
-                                               ": not a valid FRME flatbuffer (corrupt?)");
-      }
-      const fb::Frame* frame = fb::GetSizePrefixedFrame(body.data());
+      const fb::Frame* frame =
+          ReadPacket<fb::Frame>(frame_packets_.front(), kFramesType, fb::FrameIdentifier());
       width_ = frame->size_x();
       height_ = frame->size_y();
       if (width_ < 1 || height_ < 1) {
@@ -937,6 +966,7 @@ class Aedat4DataSource::File {
   size_t size_;
   Header header_;
   size_t data_end_ = 0;  // packets end here: at the data table, or at the end of the file
+  bool indexed_by_data_table_ = false;
   int width_ = 0;
   int height_ = 0;
   std::vector<Packet> event_packets_;  // sorted by time, spans not overlapping
