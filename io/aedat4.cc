@@ -810,8 +810,8 @@ class Aedat4DataSource::File {
   bool IndexFromDataTable() {
     const size_t position = static_cast<size_t>(header_.data_table_position);
     const auto* table =
-        ReadFlatbuffer<fb::FileDataTable>(data_ + position, size_ - position,
-                                          "the file data table", fb::FileDataTableIdentifier())
+        ReadFlatbuffer<fb::FileDataTable>(data_ + position, size_ - position, "the file data table",
+                                          fb::FileDataTableIdentifier())
             ->table();
     const size_t entries = table != nullptr ? table->size() : 0;
     for (size_t i = 0; i < entries; ++i) {

@@ -558,8 +558,8 @@ TEST(Aedat4StreetSampleTest, AgreesWithIndependentDecoding) {
   EXPECT_EQ(std::to_string(source.num_event_packets()), reference.at("packets"));
   const EventStream all = source.ReadAllEvents();
   const std::map<std::string, std::string> mine = EventFigures(all);
-  for (const char* key : {"sensor", "events", "positive", "first", "last", "sum_dt", "sum_x",
-                          "sum_y", "fnv1a64"}) {
+  for (const char* key :
+       {"sensor", "events", "positive", "first", "last", "sum_dt", "sum_x", "sum_y", "fnv1a64"}) {
     EXPECT_EQ(mine.at(key), reference.at(key)) << key;
   }
   ASSERT_EQ(reference.at("frames"), std::to_string(source.frames().size()));
