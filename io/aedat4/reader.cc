@@ -1,7 +1,6 @@
 // Reading AEDAT 4.0 files: Aedat4DataSource (io/aedat4.h), and recognising them.
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
