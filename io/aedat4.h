@@ -15,8 +15,12 @@
 // stream (IMU, triggers, a second camera) is skipped. When the file has a data table, opening
 // reads only it (and the frame packets, for their times and exposures): a windowed read then
 // binary-searches the packets' time spans and decompresses only the packets that overlap the
-// window. A file without one (a recording that was cut short) is indexed in one pass over its
-// packets, decompressing each event packet once.
+// window. A file without one (a recording that was cut short), or with one that does not give
+// every event packet's count and time span (tools that cut recordings write tables of offsets
+// alone), is indexed in one pass over its packets, decompressing each event packet once.
+//
+// Every flatbuffer (the IOHeader, packets, the data table) is read whether its fields are aligned
+// from its size prefix, as DV writes them, or from the flatbuffer itself, as other writers do.
 //
 // Every size and offset the file declares is checked before use, decompressed packets are
 // verified as flatbuffers before they are read, and every event is checked against the sensor,
@@ -79,7 +83,7 @@ class Aedat4DataSource : public DataSource {
   /// offset DV added to the camera's clock to make the stored times Unix times; 0 when absent.
   int64_t ts_offset_us() const;
   /// True when the packets were indexed from the file's data table, false when by a pass over
-  /// the file.
+  /// the file (it has no table, or one without event counts).
   bool indexed_by_data_table() const;
   /// Number of packets of the events stream that hold events.
   int num_event_packets() const;

@@ -14,7 +14,7 @@ packages=(
   libopencv-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev
   # summary.json (app/reconstruct_job.cc).
   nlohmann-json3-dev
-  # AEDAT 4 (io/aedat4.cc); the python3 modules decode the real sample independently in a test.
+  # AEDAT 4 (io/aedat4/); the python3 modules decode the real samples independently in tests.
   libflatbuffers-dev flatbuffers-compiler liblz4-dev libzstd-dev libtinyxml2-dev
   python3-lz4 python3-zstandard python3-flatbuffers
   # benchmarks/plot_methods.py: method_benchmark's PSNR-against-time plots.

@@ -6,7 +6,8 @@
 //                    byte to the exposures.txt beside it (see frame_list_fuzzer.cc)
 //   OUT/aedat4/      the same tiny recordings written by WriteAedat4 with each compression
 //                    (several packets each, a data table), and the header and first packets
-//                    of the real DV recording with its table position set to -1 (no table)
+//                    of the real recordings with their table position set to -1 (no table):
+//                    DV's, and one cut by another tool (its IOHeader aligned differently)
 //   OUT/hdf5_io/     tiny recordings cut from the snippets and converted to HDF5 by
 //                    ConvertRecording, the code behind `evfs convert`
 //
@@ -109,11 +110,11 @@ void WriteAedat4Seeds(const fs::path& h5_path, const fs::path& out_stem) {
   }
 }
 
-// The version line, IOHeader and first kDvSeedPackets packets of a DV recording, its
+// The version line, IOHeader and first kRealSeedPackets packets of a real recording, its
 // data_table_position (slot 1 of the IOHeader table) set to -1: a recording without a table.
-constexpr int kDvSeedPackets = 2;
+constexpr int kRealSeedPackets = 2;
 
-void WriteDvSeed(const fs::path& aedat4_path, const fs::path& seed_path) {
+void WriteRealSeed(const fs::path& aedat4_path, const fs::path& seed_path) {
   std::ifstream stream(aedat4_path, std::ios::binary);
   const std::string file((std::istreambuf_iterator<char>(stream)),
                          std::istreambuf_iterator<char>());
@@ -130,7 +131,7 @@ void WriteDvSeed(const fs::path& aedat4_path, const fs::path& seed_path) {
   std::string seed = file;
   const int64_t no_table = -1;
   std::memcpy(&seed[kVersionLineBytes + static_cast<size_t>(field - header.data())], &no_table, 8);
-  for (int packet = 0; packet < kDvSeedPackets && end + 8 <= file.size(); ++packet) {
+  for (int packet = 0; packet < kRealSeedPackets && end + 8 <= file.size(); ++packet) {
     int32_t size = 0;
     std::memcpy(&size, file.data() + end + 4, 4);
     end += 8 + static_cast<size_t>(size);
@@ -176,8 +177,10 @@ int Run(const fs::path& data_dir, const fs::path& out) {
     WriteAedat4Seeds(out / "hdf5_io" / (name + ".h5"), out / "aedat4" / name);
     WriteAedat4Seeds(out / "hdf5_io" / (name + "_ns.h5"), out / "aedat4" / (name + "_ns"));
   }
-  const fs::path dv_recording = data_dir / "aedat4_dvxplorer_sample" / "sample.aedat4";
-  if (fs::is_regular_file(dv_recording)) WriteDvSeed(dv_recording, out / "aedat4" / "dv_sample");
+  for (const char* folder : {"aedat4_dvxplorer_sample", "aedat4_davis346_street"}) {
+    const fs::path recording = data_dir / folder / "sample.aedat4";
+    if (fs::is_regular_file(recording)) WriteRealSeed(recording, out / "aedat4" / folder);
+  }
   std::printf("seed corpora from %zu snippets of %s in %s\n", snippets.size(), data_dir.c_str(),
               out.c_str());
   return 0;

@@ -19,10 +19,12 @@ prints "key values..." lines:
     first T X Y P           the first event (T in microseconds, P 1 ON / 0 OFF)
     last T X Y P            the last event
     sum_dt N                the sum over all events of their time after the first event's (us)
+    sum_x N, sum_y N        the sums of their x and of their y
     fnv1a64 HEX             FNV-1a (64 bits) over every event as int64 t, uint16 x, uint16 y,
                             uint8 p, little-endian
     frames N                frames of the first FRME stream, then one line each:
     frame I T SOE EOE W H FORMAT FNV   times in microseconds, FNV-1a of the pixel bytes
+    pixel_sum I N           the sum of frame I's pixel bytes
     table_entries N         entries of the file data table (-1 without one)
 Exit status 3 when a module is missing (the test skips), 1 for a file it cannot decode.
 """
@@ -131,10 +133,11 @@ def main(path):
     _, size_x, size_y, ts_offset = described[main_id]
 
     end = table_position if table_position >= 0 else len(data)
-    packets = events = positive = sum_dt = 0
+    packets = events = positive = sum_dt = sum_x = sum_y = 0
     digest = FNV_OFFSET
     first = last = None
     frame_lines = []
+    pixel_sums = []
     while position < end:
         stream_id, size = struct.unpack_from("<ii", data, position)
         body = data[position + 8 : position + 8 + size]
@@ -154,11 +157,14 @@ def main(path):
                 events += 1
                 positive += p
                 sum_dt += t - first[0]
+                sum_x += x
+                sum_y += y
                 digest = fnv1a64(struct.pack("<qHHB", t, x, y, p), digest)
         elif stream_id == frames_id:
             frame = root_table(decompress(compression, body), b"FRME")
             start, length = vector(frame, 10)
             pixels = bytes(frame.Bytes[start : start + length])
+            pixel_sums.append(sum(pixels))
             frame_lines.append(
                 " ".join(
                     str(v)
@@ -189,10 +195,14 @@ def main(path):
         print("first %d %d %d %d" % first)
         print("last %d %d %d %d" % last)
     print(f"sum_dt {sum_dt}")
+    print(f"sum_x {sum_x}")
+    print(f"sum_y {sum_y}")
     print(f"fnv1a64 {digest:016x}")
     print(f"frames {len(frame_lines)}")
     for i, line in enumerate(frame_lines):
         print(f"frame {i} {line}")
+    for i, pixel_sum in enumerate(pixel_sums):
+        print(f"pixel_sum {i} {pixel_sum}")
     print(f"table_entries {table_entries}")
 
 

@@ -33,6 +33,9 @@ using test::MakeRandomEvents;
 using test::ScratchDir;
 
 constexpr char kSampleFolder[] = "aedat4_dvxplorer_sample";
+// A DAVIS346 recording cut by another tool than DV: its IOHeader is aligned from the flatbuffer,
+// not from the size prefix, and its data table gives offsets alone (no counts, no times).
+constexpr char kStreetFolder[] = "aedat4_davis346_street";
 constexpr char kSampleFile[] = "sample.aedat4";
 constexpr char kVersionLine[] = "#!AER-DAT4.0\r\n";
 constexpr int64_t kNsPerUs = 1000;
@@ -60,6 +63,8 @@ std::map<std::string, std::string> EventFigures(const EventStream& events) {
   std::map<std::string, std::string> figures;
   int64_t positive = 0;
   int64_t sum_dt = 0;
+  int64_t sum_x = 0;
+  int64_t sum_y = 0;
   uint64_t hash = kFnvOffset;
   const auto describe = [&](size_t i) {
     return std::to_string(events.t_ns(i) / kNsPerUs) + " " + std::to_string(events.x(i)) + " " +
@@ -70,6 +75,8 @@ std::map<std::string, std::string> EventFigures(const EventStream& events) {
     const uint8_t p = events.polarity(i) > 0 ? 1 : 0;
     positive += p;
     sum_dt += t_us - events.t_ns(0) / kNsPerUs;
+    sum_x += events.x(i);
+    sum_y += events.y(i);
     uint8_t packed[13];
     for (int b = 0; b < 8; ++b)
       packed[b] = static_cast<uint8_t>(static_cast<uint64_t>(t_us) >> (8 * b));
@@ -84,6 +91,8 @@ std::map<std::string, std::string> EventFigures(const EventStream& events) {
   figures["events"] = std::to_string(events.size());
   figures["positive"] = std::to_string(positive);
   figures["sum_dt"] = std::to_string(sum_dt);
+  figures["sum_x"] = std::to_string(sum_x);
+  figures["sum_y"] = std::to_string(sum_y);
   figures["fnv1a64"] = Hex64(hash);
   if (!events.empty()) {
     figures["first"] = describe(0);
@@ -113,8 +122,8 @@ std::string ReferencePython() {
                     "independent decoding";                                               \
   }
 
-// Runs the script on `path`; its output lines as key -> rest of the line ("frame" keys get
-// their index appended: "frame 0").
+// Runs the script on `path`; its output lines as key -> rest of the line (the per-frame keys
+// get their index appended: "frame 0", "pixel_sum 0").
 std::map<std::string, std::string> RunReferenceDecoder(const std::string& python,
                                                        const std::string& path) {
   const std::string command =
@@ -134,7 +143,7 @@ std::map<std::string, std::string> RunReferenceDecoder(const std::string& python
     std::istringstream fields(line);
     std::string key;
     fields >> key;
-    if (key == "frame") {
+    if (key == "frame" || key == "pixel_sum") {
       std::string index;
       fields >> index;
       key += " " + index;
@@ -180,7 +189,27 @@ std::string Le32(int32_t value) {
   return bytes;
 }
 
-std::string HeaderBytes(int32_t compression, int64_t data_table_position, const std::string& xml) {
+// How a writer puts the size in front of a flatbuffer. A builder aligns every field from the
+// end of the buffer and pads its front to a whole number of the largest alignment (8 bytes
+// here): DV finishes with the size prefix inside that whole (FinishSizePrefixed), other writers
+// finish the flatbuffer alone and then write its size in front, so that every field lies 4 bytes
+// off where DV's would, counted from the prefix.
+enum class Layout { kDv, kSizeWrittenAfter };
+
+// The size-prefixed flatbuffer whose root table `root` is in `builder`.
+std::string Finish(flatbuffers::FlatBufferBuilder* builder, flatbuffers::uoffset_t root,
+                   const char* identifier, Layout layout) {
+  const flatbuffers::Offset<flatbuffers::Table> table(root);
+  if (layout == Layout::kDv) {
+    builder->FinishSizePrefixed(table, identifier);
+    return Bytes(*builder);
+  }
+  builder->Finish(table, identifier);
+  return Le32(static_cast<int32_t>(builder->GetSize())) + Bytes(*builder);
+}
+
+std::string HeaderBytes(int32_t compression, int64_t data_table_position, const std::string& xml,
+                        Layout layout = Layout::kDv) {
   flatbuffers::FlatBufferBuilder builder;
   builder.ForceDefaults(true);
   const auto info = builder.CreateString(xml);
@@ -188,24 +217,20 @@ std::string HeaderBytes(int32_t compression, int64_t data_table_position, const 
   builder.AddElement<int32_t>(Slot(0), compression, 0);
   builder.AddElement<int64_t>(Slot(1), data_table_position, -1);
   builder.AddOffset(Slot(2), info);
-  builder.FinishSizePrefixed(flatbuffers::Offset<flatbuffers::Table>(builder.EndTable(start)),
-                             "IOHE");
-  return kVersionLine + Bytes(builder);
+  return kVersionLine + Finish(&builder, builder.EndTable(start), "IOHE", layout);
 }
 
-std::string EventPacketBody(const std::vector<RawEvent>& events) {
+std::string EventPacketBody(const std::vector<RawEvent>& events, Layout layout = Layout::kDv) {
   flatbuffers::FlatBufferBuilder builder;
   const auto elements = builder.CreateVectorOfStructs(events.data(), events.size());
   const auto start = builder.StartTable();
   builder.AddOffset(Slot(0), elements);
-  builder.FinishSizePrefixed(flatbuffers::Offset<flatbuffers::Table>(builder.EndTable(start)),
-                             "EVTS");
-  return Bytes(builder);
+  return Finish(&builder, builder.EndTable(start), "EVTS", layout);
 }
 
 std::string FrameBody(int64_t t_us, int64_t exposure_begin_us, int64_t exposure_end_us,
                       int8_t format, int16_t width, int16_t height,
-                      const std::vector<uint8_t>& pixels) {
+                      const std::vector<uint8_t>& pixels, Layout layout = Layout::kDv) {
   flatbuffers::FlatBufferBuilder builder;
   const auto pixel_vector = builder.CreateVector(pixels);
   const auto start = builder.StartTable();
@@ -216,9 +241,7 @@ std::string FrameBody(int64_t t_us, int64_t exposure_begin_us, int64_t exposure_
   builder.AddElement<int16_t>(Slot(6), width, 0);
   builder.AddElement<int16_t>(Slot(7), height, 0);
   builder.AddOffset(Slot(10), pixel_vector);
-  builder.FinishSizePrefixed(flatbuffers::Offset<flatbuffers::Table>(builder.EndTable(start)),
-                             "FRME");
-  return Bytes(builder);
+  return Finish(&builder, builder.EndTable(start), "FRME", layout);
 }
 
 struct TableEntry {
@@ -229,7 +252,7 @@ struct TableEntry {
   int64_t t_last_us;
 };
 
-std::string DataTableBody(const std::vector<TableEntry>& entries) {
+std::string DataTableBody(const std::vector<TableEntry>& entries, Layout layout = Layout::kDv) {
   flatbuffers::FlatBufferBuilder builder;
   std::vector<flatbuffers::Offset<flatbuffers::Table>> tables;
   for (const TableEntry& entry : entries) {
@@ -244,9 +267,7 @@ std::string DataTableBody(const std::vector<TableEntry>& entries) {
   const auto vector = builder.CreateVector(tables);
   const auto start = builder.StartTable();
   builder.AddOffset(Slot(0), vector);
-  builder.FinishSizePrefixed(flatbuffers::Offset<flatbuffers::Table>(builder.EndTable(start)),
-                             "FTAB");
-  return Bytes(builder);
+  return Finish(&builder, builder.EndTable(start), "FTAB", layout);
 }
 
 // DV's stream description for the given streams: (id, type, sizeX, sizeY); sizeX 0 omits the
@@ -294,14 +315,23 @@ std::vector<uint8_t> HandGreyPixels() {
 // Every pixel (blue, green, red) = (10, 200, 60).
 constexpr uint8_t kBgr[3] = {10, 200, 60};
 
-std::vector<std::string> HandPackets() {
+// The layout of each kind of flatbuffer in a hand-built file.
+struct Layouts {
+  Layout header = Layout::kDv;
+  Layout events = Layout::kDv;
+  Layout frames = Layout::kDv;
+  Layout table = Layout::kDv;
+};
+
+std::vector<std::string> HandPackets(const Layouts& layouts) {
   std::vector<uint8_t> bgr;
   for (int i = 0; i < kHandWidth * kHandHeight; ++i) bgr.insert(bgr.end(), kBgr, kBgr + 3);
-  return {Packet(0, EventPacketBody({kHandEvents[0], kHandEvents[1]})),
+  return {Packet(0, EventPacketBody({kHandEvents[0], kHandEvents[1]}, layouts.events)),
           Packet(2, std::string(24, '\x7f')),
-          Packet(5, FrameBody(200, 150, 250, 0, kHandWidth, kHandHeight, HandGreyPixels())),
-          Packet(0, EventPacketBody({kHandEvents[2]})),
-          Packet(5, FrameBody(400, 0, 0, 16, kHandWidth, kHandHeight, bgr))};
+          Packet(5, FrameBody(200, 150, 250, 0, kHandWidth, kHandHeight, HandGreyPixels(),
+                              layouts.frames)),
+          Packet(0, EventPacketBody({kHandEvents[2]}, layouts.events)),
+          Packet(5, FrameBody(400, 0, 0, 16, kHandWidth, kHandHeight, bgr, layouts.frames))};
 }
 
 std::string HandXml() {
@@ -311,22 +341,23 @@ std::string HandXml() {
 }
 
 // The hand-built file without a data table.
-std::string HandBuiltFile() {
-  std::string file = HeaderBytes(0, -1, HandXml());
-  for (const std::string& packet : HandPackets()) file += packet;
+std::string HandBuiltFile(const Layouts& layouts = Layouts()) {
+  std::string file = HeaderBytes(0, -1, HandXml(), layouts.header);
+  for (const std::string& packet : HandPackets(layouts)) file += packet;
   return file;
 }
 
 // The same with a data table for every packet; `mutate` may change the entries first.
 template <typename Mutate>
-std::string HandBuiltFileWithTable(Mutate&& mutate) {
-  const std::string probe = HeaderBytes(0, 1, HandXml());  // same size for every position
+std::string HandBuiltFileWithTable(Mutate&& mutate, const Layouts& layouts = Layouts()) {
+  // The same size for every position.
+  const std::string probe = HeaderBytes(0, 1, HandXml(), layouts.header);
   std::string packets;
   std::vector<TableEntry> entries;
   const std::vector<std::vector<RawEvent>> event_packets = {{kHandEvents[0], kHandEvents[1]},
                                                             {kHandEvents[2]}};
   size_t event_packet = 0;
-  for (const std::string& packet : HandPackets()) {
+  for (const std::string& packet : HandPackets(layouts)) {
     RawPacketHeader header;
     std::memcpy(&header, packet.data(), sizeof(header));
     TableEntry entry{static_cast<int64_t>(probe.size() + packets.size() + 8), header, 1, 0, 0};
@@ -340,8 +371,9 @@ std::string HandBuiltFileWithTable(Mutate&& mutate) {
     packets += packet;
   }
   mutate(&entries);
-  return HeaderBytes(0, static_cast<int64_t>(probe.size() + packets.size()), HandXml()) + packets +
-         DataTableBody(entries);
+  return HeaderBytes(0, static_cast<int64_t>(probe.size() + packets.size()), HandXml(),
+                     layouts.header) +
+         packets + DataTableBody(entries, layouts.table);
 }
 
 std::string HandBuiltFileWithTable() {
@@ -473,6 +505,84 @@ TEST(Aedat4RealSampleTest, OpensThroughDataSourceAndIsNotEvfsOwn) {
   EXPECT_EQ(source->height(), 240);
   EXPECT_TRUE(source->has_events());
   EXPECT_FALSE(IsAedat4WrittenByEvfs(path));
+}
+
+// What `evfs info` shows of it, the figures its source gives.
+TEST(Aedat4StreetSampleTest, ReadsItsFramesAndEvents) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  const std::string path = data_dir + "/" + kStreetFolder + "/" + kSampleFile;
+  const auto opened = DataSource::Open(path);
+  const auto* source = dynamic_cast<const Aedat4DataSource*>(opened.get());
+  ASSERT_NE(source, nullptr);
+  EXPECT_FALSE(IsAedat4WrittenByEvfs(path));
+  EXPECT_EQ(source->compression(), Aedat4Compression::kLz4);
+  // Its table gives no event counts, so the packets were indexed by a pass over them.
+  EXPECT_FALSE(source->indexed_by_data_table());
+  EXPECT_EQ(source->width(), 346);
+  EXPECT_EQ(source->height(), 260);
+  ASSERT_EQ(source->frames().size(), 4u);
+  // 25 frames per second, each exposed 0.5 ms around its time.
+  constexpr int64_t kFramePeriodNs = 40000000;
+  constexpr int64_t kHalfExposureNs = 250000;
+  for (size_t k = 0; k < 4; ++k) {
+    const FrameInfo& frame = source->frames()[k];
+    EXPECT_EQ(frame.t_ns, source->frames()[0].t_ns + static_cast<int64_t>(k) * kFramePeriodNs);
+    EXPECT_TRUE(frame.has_exposure);
+    EXPECT_EQ(frame.exposure_begin_ns, frame.t_ns - kHalfExposureNs) << k;
+    EXPECT_EQ(frame.exposure_end_ns, frame.t_ns + kHalfExposureNs) << k;
+    const Image image = source->ReadImage(static_cast<int>(k));
+    EXPECT_EQ(image.rows(), 260);
+    EXPECT_EQ(image.cols(), 346);
+  }
+  const EventStream all = source->ReadAllEvents();
+  EXPECT_EQ(all.size(), 6676u);
+  EXPECT_EQ(source->Summarize().count, 6676);
+  for (size_t k = 0; k + 1 < 4; ++k) {
+    const int64_t begin = source->frames()[k].t_ns;
+    const int64_t end = source->frames()[k + 1].t_ns;
+    const EventStream between = source->ReadEvents(begin, end);
+    EXPECT_FALSE(between.empty()) << k;
+    EXPECT_EQ(between, all.Slice(begin, end)) << k;
+  }
+}
+
+TEST(Aedat4StreetSampleTest, AgreesWithIndependentDecoding) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  EVFS_REQUIRE_REFERENCE_PYTHON(python);
+  const std::string path = data_dir + "/" + kStreetFolder + "/" + kSampleFile;
+  const std::map<std::string, std::string> reference = RunReferenceDecoder(python, path);
+
+  const Aedat4DataSource source(path);
+  EXPECT_EQ(reference.at("compression"), "1");
+  EXPECT_EQ(std::to_string(source.ts_offset_us()), reference.at("ts_offset_us"));
+  EXPECT_EQ(std::to_string(source.num_event_packets()), reference.at("packets"));
+  const EventStream all = source.ReadAllEvents();
+  const std::map<std::string, std::string> mine = EventFigures(all);
+  for (const char* key :
+       {"sensor", "events", "positive", "first", "last", "sum_dt", "sum_x", "sum_y", "fnv1a64"}) {
+    EXPECT_EQ(mine.at(key), reference.at(key)) << key;
+  }
+  ASSERT_EQ(reference.at("frames"), std::to_string(source.frames().size()));
+  for (size_t k = 0; k < source.frames().size(); ++k) {
+    const FrameInfo& frame = source.frames()[k];
+    const Image image = source.ReadImage(static_cast<int>(k));
+    std::vector<uint8_t> pixels;
+    int64_t pixel_sum = 0;
+    for (Eigen::Index row = 0; row < image.rows(); ++row) {
+      for (Eigen::Index column = 0; column < image.cols(); ++column) {
+        pixels.push_back(static_cast<uint8_t>(std::lround(image(row, column) * 255.0)));
+        pixel_sum += pixels.back();
+      }
+    }
+    const std::string index = std::to_string(k);
+    // Grey frames (format 0) of the whole sensor.
+    EXPECT_EQ(reference.at("frame " + index),
+              std::to_string(frame.t_ns / kNsPerUs) + " " +
+                  std::to_string(frame.exposure_begin_ns / kNsPerUs) + " " +
+                  std::to_string(frame.exposure_end_ns / kNsPerUs) + " 346 260 0 " +
+                  Hex64(Fnv1a(pixels.data(), pixels.size())));
+    EXPECT_EQ(reference.at("pixel_sum " + index), std::to_string(pixel_sum));
+  }
 }
 
 // `copy` holds the recording `original` as an AEDAT 4 file can: the frames exactly (pixels,
@@ -817,6 +927,49 @@ TEST(Aedat4HandBuiltTest, FramesOnly) {
   EXPECT_EQ(source->Summarize().count, 0);
   EXPECT_THROW(source->ReadAllEvents(), InputError);
   EXPECT_EQ(source->frames().size(), 1u);
+}
+
+// Every flatbuffer of a file, aligned from its size prefix (DV) or from itself (other writers),
+// in every combination.
+TEST(Aedat4HandBuiltTest, FlatbuffersAlignedFromTheirSizePrefixOrFromThemselves) {
+  // The two layouts differ where the test needs them to: DV's flatbuffer with its prefix is a
+  // whole number of 8 bytes, the other's flatbuffer alone is.
+  const size_t prefix_at = std::strlen(kVersionLine);
+  ASSERT_EQ((HeaderBytes(0, -1, HandXml(), Layout::kDv).size() - prefix_at) % 8, 0u);
+  ASSERT_EQ((HeaderBytes(0, -1, HandXml(), Layout::kSizeWrittenAfter).size() - prefix_at - 4) % 8,
+            0u);
+  for (int combination = 0; combination < 16; ++combination) {
+    const auto layout = [&](int bit) {
+      return (combination >> bit & 1) != 0 ? Layout::kSizeWrittenAfter : Layout::kDv;
+    };
+    Layouts layouts;
+    layouts.header = layout(0);
+    layouts.events = layout(1);
+    layouts.frames = layout(2);
+    layouts.table = layout(3);
+    SCOPED_TRACE("combination " + std::to_string(combination));
+    const std::string scanned_bytes = HandBuiltFile(layouts);
+    const auto scanned = FromBytes(scanned_bytes);
+    EXPECT_FALSE(scanned->indexed_by_data_table());
+    ExpectHandBuiltRecording(*scanned);
+    const std::string indexed_bytes =
+        HandBuiltFileWithTable([](std::vector<TableEntry>*) {}, layouts);
+    const auto indexed = FromBytes(indexed_bytes);
+    EXPECT_TRUE(indexed->indexed_by_data_table());
+    ExpectHandBuiltRecording(*indexed);
+  }
+}
+
+// A data table of offsets alone, as tools that cut recordings write it: the packets are indexed
+// by a pass over them, which stops at the table.
+TEST(Aedat4HandBuiltTest, DataTableWithoutCountsIsNotUsedAsAnIndex) {
+  const std::string bytes = HandBuiltFileWithTable([](std::vector<TableEntry>* entries) {
+    for (TableEntry& entry : *entries) entry = {entry.byte_offset, entry.header, 0, 0, 0};
+  });
+  const auto source = FromBytes(bytes);
+  EXPECT_FALSE(source->indexed_by_data_table());
+  EXPECT_EQ(source->num_event_packets(), 2);
+  ExpectHandBuiltRecording(*source);
 }
 
 // ---------------------------------------------------------------------------------------------
