@@ -40,9 +40,6 @@ constexpr char kEvfs[] = "evfs";
 constexpr size_t kMaxImageNameBytes = 64;
 // Event coordinates are uint16, so no sensor side is longer.
 constexpr hsize_t kMaxImageSide = 65536;
-// Most pixels a sensor may have (8192 x 8192, far beyond any event camera's 1280 x 960): a
-// declared size is allocated for (frames, per-pixel counts), so it is bounded before it is.
-constexpr int64_t kMaxSensorPixels = int64_t{1} << 26;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
 
