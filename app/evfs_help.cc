@@ -122,6 +122,7 @@ ProgramHelp MakeEvfsHelp() {
       {"min_blur_exposure_s", "data", "video"},
       {"frame_step", "data", "video"},
       {"skip_bad_frames", "data", "video"},
+      {"allow_outside_paths", "data", "info reconstruct convert video simulate"},
       // The event simulator.
       {"threshold_pos", "simulator", "simulate"},
       {"threshold_neg", "simulator", "simulate"},

@@ -47,6 +47,7 @@
 #include "events/simulator.h"
 #include "io/aedat4.h"
 #include "io/data_source.h"
+#include "io/frame_list.h"
 #include "io/hdf5_io.h"
 #include "io/output_target.h"
 #include "io/text_folder.h"
@@ -258,6 +259,9 @@ DEFINE_int32(frame_step, 1,
              "every frame.");
 DEFINE_bool(skip_bad_frames, false,
             "video: leave out missing or unreadable frames and reconstruct across the gap.");
+DEFINE_bool(allow_outside_paths, false,
+            "read frames that images.txt names outside the recording's folder (absolute paths, "
+            "'..').");
 // Simulator.
 DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos,
               "simulate: ON contrast threshold (log intensity).");
@@ -604,6 +608,7 @@ int RunVideoCommand(ProgressReporter* progress) {
 }
 
 int RunCommand(const std::string& command) {
+  SetFramePathsMayLeaveFolder(FLAGS_allow_outside_paths);
   Require(std::isfinite(FLAGS_progress_interval_s) && FLAGS_progress_interval_s >= 0.0,
           "--progress_interval_s must be a number of seconds, 0 or more");
   // Lines on stderr while the command runs, only when it runs long (app/progress.h).

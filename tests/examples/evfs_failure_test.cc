@@ -132,6 +132,37 @@ TEST(EvfsFailure, DataFileThatIsNoRegularFileIsNamedAsSuch) {
                   images_txt.string() + ": a folder, not a file of frames ('t path' lines)", out);
 }
 
+// A frame path in images.txt that leaves the recording's folder is refused on its line, for
+// every command that reads frames, unless --allow_outside_paths is given.
+TEST(EvfsFailure, FramePathsOutsideTheRecordingNeedAFlag) {
+  const fs::path scratch = test::ScratchDir("failure_outside_paths");
+  const fs::path out = scratch / "out";
+  const fs::path data = WriteSyntheticFolder(scratch.string());
+  const fs::path images_txt = data / "images.txt";
+  std::string list = test::ReadFile(images_txt);
+  const std::string first = "images/frame_0.png";
+  fs::copy_file(data / first, scratch / "outside.png");
+  for (const std::string& outside : {std::string("../outside.png"),
+                                     (scratch / "outside.png").string()}) {
+    SCOPED_TRACE(outside);
+    std::string changed = list;
+    changed.replace(changed.find(first), first.size(), outside);
+    test::WriteFile(images_txt.string(), changed);
+    for (const std::string& command :
+         {"info --data=" + data.string(),
+          "reconstruct --data=" + data.string() + " --mode=predict --first=0 --out=" +
+              out.string(),
+          "convert --data=" + data.string() + " --out=" + out.string()}) {
+      SCOPED_TRACE(command);
+      ExpectUserError(RunEvfs(command), images_txt.string() + ":1", out);
+      const CommandResult allowed = RunEvfs(command + " --allow_outside_paths");
+      EXPECT_EQ(allowed.exit_code, 0) << allowed.output;
+      fs::remove_all(out);
+    }
+  }
+  test::WriteFile(images_txt.string(), list);
+}
+
 // A folder without images.txt is events alone: `info` describes it (status 0) and says why it
 // lists no frame; reading a frame says the same instead of "has 0 frames (0..-1)".
 TEST(EvfsFailure, MissingFrameListIsNamed) {
