@@ -454,7 +454,8 @@ void WritePreview(const std::vector<VideoWindow>& windows, const SharedSource& s
 bool VideoRequest::IsValid(std::string* error) const {
   OptionChecker check;
   check.Valid(windows)
-      .Require(std::isfinite(fps) && fps >= 0.0, "--fps", "a number of frames per second >= 0")
+      .Require(std::isfinite(fps) && (fps == 0.0 || fps >= kMinVideoFps), "--fps",
+               "0 (derived) or at least 1 frame per second")
       .InRange("--jobs", jobs, 0, 4096)
       .InRange("--threads", threads_per_window, 0, 4096)
       .Valid(method.reconstruction)

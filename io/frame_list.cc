@@ -60,8 +60,13 @@ std::ifstream OpenForReading(const std::string& path) {
 // the content trimmed of surrounding blanks and a trailing '\r'.
 void ForEachContentLine(std::istream& stream,
                         const std::function<void(int64_t, const std::string&)>& visit) {
+  // A UTF-8 byte-order mark, which some Windows editors put first, is no part of the text.
+  static const std::string kByteOrderMark = "\xEF\xBB\xBF";
   std::string line;
   for (int64_t line_number = 1; std::getline(stream, line); ++line_number) {
+    if (line_number == 1 && line.compare(0, kByteOrderMark.size(), kByteOrderMark) == 0) {
+      line.erase(0, kByteOrderMark.size());
+    }
     const std::string content = Trim(line);
     if (content.empty() || content[0] == '#') continue;
     visit(line_number, content);

@@ -523,9 +523,16 @@ class Hdf5DataSource::File {
     if (H5Sget_simple_extent_npoints(space.get()) != 2)
       h5_.Fail(InputError::Kind::kMalformed, what + " must hold [height, width]");
     h5_.CheckStatus(H5Aread(attribute.get(), H5T_NATIVE_INT64, resolution), "unreadable " + what);
-    if (resolution[0] <= 0 || resolution[1] <= 0 || resolution[0] > 65536 ||
-        resolution[1] > 65536) {
+    if (resolution[0] <= 0 || resolution[1] <= 0) {
       h5_.Fail(InputError::Kind::kOutOfRange, what + " must hold a positive [height, width]");
+    }
+    if (resolution[0] > static_cast<int64_t>(kMaxImageSide) ||
+        resolution[1] > static_cast<int64_t>(kMaxImageSide)) {
+      h5_.Fail(InputError::Kind::kOutOfRange,
+               what + " declares a " + std::to_string(resolution[1]) + "x" +
+                   std::to_string(resolution[0]) + " sensor: beyond the " +
+                   std::to_string(kMaxImageSide) + " pixels a side and " +
+                   std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
     }
     CheckSensorPixels(what + " declares a", resolution[1], resolution[0]);
     height_ = static_cast<int>(resolution[0]);

@@ -1,5 +1,8 @@
 #include "io/image_io.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -122,9 +125,23 @@ bool ReadImageHeaderSize(const std::string& path, int64_t* width, int64_t* heigh
 
 Image ReadGreyImage(const std::string& path, int expected_width, int expected_height,
                     const std::string& expected_what) {
+  // What stands at the path is named: a folder, a FIFO or a file without read permission is
+  // not a missing file, and none of them an undecodable one.
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (!std::filesystem::exists(status)) {
     throw InputError(InputError::Kind::kMissingFile, path, 0, "image file does not exist");
+  }
+  if (std::filesystem::is_directory(status)) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0, "a folder, not an image file");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0,
+                     "a FIFO, socket or device, not an image file");
+  }
+  if (::access(path.c_str(), R_OK) != 0) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0,
+                     std::string("cannot read the image file: ") + std::strerror(errno));
   }
   const auto size_text = [](int64_t width, int64_t height) {
     return std::to_string(width) + "x" + std::to_string(height);

@@ -103,6 +103,16 @@ TEST(ReadFrameListTest, PathsLeavingTheFolderAreRefusedUnlessAllowed) {
   EXPECT_EQ(frames[2].path, "/abs/y.png");
 }
 
+// Some Windows editors start a UTF-8 file with a byte-order mark; it is no part of the first path.
+TEST(ReadFrameListTest, AByteOrderMarkIsSkipped) {
+  const std::string path =
+      TextFile("frames_bom", "images.txt", "\xEF\xBB\xBF" "1.5 images/a.png\n2.5 images/b.png\n");
+  const std::vector<FrameInfo> frames = ReadFrameList(path);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].t_ns, 1500000000);
+  EXPECT_EQ(frames[0].path, "images/a.png");
+}
+
 TEST(ReadFrameListTest, TruncatedLastLineIsMalformed) {
   // A file cut short while it was written: the last line lacks its path and its newline.
   const std::string path =

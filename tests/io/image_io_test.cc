@@ -1,6 +1,10 @@
 #include "io/image_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -135,6 +139,32 @@ TEST(ImageIoTest, AHugeOrMismatchedDeclaredSizeIsRefusedBeforeDecoding) {
                          InputError::Kind::kSizeMismatch, dir + "/other.png", 0);
   ASSERT_TRUE(cv::imwrite(dir + "/fits.png", cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(7))));
   EXPECT_EQ(ReadGreyImage(dir + "/fits.png", kWidth, kHeight).cols(), kWidth);
+}
+
+// A folder, a FIFO or an unreadable file where a frame should be is named as what it is, not as
+// a missing file or one that does not decode.
+TEST(ImageIoTest, AFolderAFifoOrAnUnreadableFileIsNamed) {
+  const std::string dir = test::ScratchDir("image_not_a_file");
+  std::filesystem::create_directories(dir + "/folder.png");
+  ASSERT_EQ(mkfifo((dir + "/fifo.png").c_str(), 0600), 0);
+  const auto message = [](const std::string& path) {
+    try {
+      ReadGreyImage(path);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(dir + "/folder.png").find("a folder, not an image file"), std::string::npos)
+      << message(dir + "/folder.png");
+  EXPECT_NE(message(dir + "/fifo.png").find("a FIFO, socket or device"), std::string::npos)
+      << message(dir + "/fifo.png");
+  if (geteuid() == 0) GTEST_SKIP() << "running as root: file permissions do not stop reading";
+  ASSERT_TRUE(cv::imwrite(dir + "/locked.png", cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(7))));
+  std::filesystem::permissions(dir + "/locked.png", std::filesystem::perms::none);
+  EXPECT_NE(message(dir + "/locked.png").find("cannot read the image file: Permission denied"),
+            std::string::npos)
+      << message(dir + "/locked.png");
 }
 
 TEST(ImageIoTest, UnwritableImageIsAnInputError) {
