@@ -532,8 +532,7 @@ void OutputTarget::RemoveLeftovers() const {
   }
   for (const fs::path& leftover : leftovers) {
     // Only what evfs shows to be its own goes: an empty folder or file, a staging folder (its
-    // marker says so), an earlier output holding nothing but what its marker lists, or a file
-    // the caller's predicate recognises.
+    // marker says so), or an earlier output holding nothing but what its marker lists.
     std::error_code status_error;
     const fs::file_status status = fs::symlink_status(leftover, status_error);
     bool own = false;
@@ -547,8 +546,9 @@ void OutputTarget::RemoveLeftovers() const {
                                     !list_error);
       }
     } else if (fs::is_regular_file(status) && is_file) {
-      own = fs::file_size(leftover, status_error) == 0 ||
-            (options_.is_own_file && options_.is_own_file(leftover.string()));
+      // A staging file holds no marker, and a half-written one is not parsed (libhdf5 may crash
+      // on it): only an empty one is known to be evfs's.
+      own = fs::file_size(leftover, status_error) == 0 && !status_error;
     }
     if (!own) continue;
     std::error_code remove_error;
