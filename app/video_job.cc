@@ -102,8 +102,7 @@ std::vector<std::string> WorkFolderForeign(const fs::path& folder,
     std::error_code status_error;
     const fs::file_status status = it->symlink_status(status_error);
     const bool is_folder = fs::is_directory(status);
-    if (IsWorkFolderPath(relative, is_folder) &&
-        (is_folder || fs::is_regular_file(status))) {
+    if (IsWorkFolderPath(relative, is_folder) && (is_folder || fs::is_regular_file(status))) {
       if (!is_folder && own_files != nullptr) own_files->push_back(it->path());
       continue;
     }
@@ -152,9 +151,10 @@ std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string&
     // A work folder is reused or replaced whole: nothing the user added may be mixed in or lost.
     const std::vector<std::string> foreign = WorkFolderForeign(folder);
     if (!foreign.empty()) {
-      throw InvalidArgumentError(folder.string() + " (the work folder of this video) holds what "
-                                 "evfs did not write: " + NameSome(foreign) +
-                                 "; move that away");
+      throw InvalidArgumentError(folder.string() +
+                                 " (the work folder of this video) holds what "
+                                 "evfs did not write: " +
+                                 NameSome(foreign) + "; move that away");
     }
   }
   const std::string marker_text = std::string(kWorkMarkerTitle) + "\n" + fingerprint;

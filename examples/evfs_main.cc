@@ -470,8 +470,8 @@ int RunDenoise() {
 int RunReconstruct(ProgressReporter* progress) {
   Require(!FLAGS_data.empty(), "reconstruct needs --data=DIR or --data=FILE.h5");
   Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
-  Require(FLAGS_first >= -1, "--first=" + std::to_string(FLAGS_first) +
-                                 ": a frame number must be 0 or more");
+  Require(FLAGS_first >= -1,
+          "--first=" + std::to_string(FLAGS_first) + ": a frame number must be 0 or more");
   Require(FLAGS_first >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
   ReconstructRequest request = RequestFromFlags();
   OutputTarget out(OutputFromFlags("reconstruct", FLAGS_data));
@@ -510,8 +510,8 @@ std::string VideoSettings() {
 int RunVideoCommand(ProgressReporter* progress) {
   Require(!FLAGS_data.empty(), "video needs --data=DIR or --data=FILE.h5");
   Require(!FLAGS_out.empty(), "video needs --out=DIR");
-  Require(FLAGS_first >= -1, "--first=" + std::to_string(FLAGS_first) +
-                                 ": a frame number must be 0 or more");
+  Require(FLAGS_first >= -1,
+          "--first=" + std::to_string(FLAGS_first) + ": a frame number must be 0 or more");
   Require(FLAGS_last >= -1,
           "--last=" + std::to_string(FLAGS_last) + ": a frame number must be 0 or more");
   const ReconstructRequest reconstruct = RequestFromFlags(/*with_mode=*/false);

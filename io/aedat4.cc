@@ -299,9 +299,9 @@ class HeaderParser {
     if (!StartsWith(data_, size_, kVersionLine, kVersionLineBytes)) {
       if (size_ < kVersionLineBytes && size_ >= kAedatPrefixBytes &&
           std::memcmp(data_, kVersionLine, size_) == 0) {
-        Fail(InputError::Kind::kMalformed,
-             "truncated inside the version line (" + std::to_string(size_) + " of its " +
-                 std::to_string(kVersionLineBytes) + " bytes)");
+        Fail(InputError::Kind::kMalformed, "truncated inside the version line (" +
+                                               std::to_string(size_) + " of its " +
+                                               std::to_string(kVersionLineBytes) + " bytes)");
       }
       if (StartsWith(data_, size_, kAedatPrefix, kAedatPrefixBytes)) {
         const size_t shown = std::min<size_t>(size_, kAedatPrefixBytes + 3);

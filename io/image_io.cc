@@ -151,10 +151,10 @@ Image ReadGreyImage(const std::string& path, int expected_width, int expected_he
   if (ReadImageHeaderSize(path, &width, &height)) {
     if (expected_width > 0 && expected_height > 0 &&
         (width != expected_width || height != expected_height)) {
-      throw InputError(InputError::Kind::kSizeMismatch, path, 0,
-                       "image is " + size_text(width, height) + ", expected " +
-                           (expected_what.empty() ? size_text(expected_width, expected_height)
-                                                  : expected_what));
+      throw InputError(
+          InputError::Kind::kSizeMismatch, path, 0,
+          "image is " + size_text(width, height) + ", expected " +
+              (expected_what.empty() ? size_text(expected_width, expected_height) : expected_what));
     }
     if (width * height > kMaxSensorPixels) {
       throw InputError(InputError::Kind::kOutOfRange, path, 0,

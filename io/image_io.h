@@ -23,8 +23,8 @@ bool ReadImageHeaderSize(const std::string& path, int64_t* width, int64_t* heigh
 /// divided by 255, 16-bit ones by 65535. The size its header declares is checked before any
 /// pixel is decoded: more than kMaxSensorPixels is InputError(kOutOfRange), and when
 /// `expected_width` and `expected_height` are not 0, another size is
-/// InputError(kSizeMismatch) ("expected `expected_what`", which names the size). Throws InputError(kMissingFile) when
-/// the file is missing or cannot be decoded.
+/// InputError(kSizeMismatch) ("expected `expected_what`", which names the size). Throws
+/// InputError(kMissingFile) when the file is missing or cannot be decoded.
 Image ReadGreyImage(const std::string& path, int expected_width = 0, int expected_height = 0,
                     const std::string& expected_what = "");
 

@@ -79,7 +79,7 @@ bool IsSameOrInside(const fs::path& inner, const fs::path& outer) {
 struct Marker {
   enum class State { kMissing, kSymlink, kNotAFile, kUnreadable, kRead };
   State state = State::kMissing;
-  std::string command;           // its first line: "evfs reconstruct"
+  std::string command;            // its first line: "evfs reconstruct"
   std::set<std::string> entries;  // "folder frames", "file frames/000000.png"
   bool unfinished = false;        // a staging folder's marker
 };
@@ -515,8 +515,7 @@ void OutputTarget::RemoveReplaced(const fs::path& replaced) const {
   RemoveOwnTree(replaced, &error);
   if (error) {
     Warn("the earlier output of " + path_ + " was replaced but cannot be removed from " +
-         replaced.string() + " (" + error.message() + "); a later run on " + path_ +
-         " removes it");
+         replaced.string() + " (" + error.message() + "); a later run on " + path_ + " removes it");
   }
 }
 
@@ -542,8 +541,8 @@ void OutputTarget::RemoveLeftovers() const {
         own = true;
       } else if (marker.state == Marker::State::kRead && marker.command.rfind("evfs ", 0) == 0) {
         std::error_code list_error;
-        own = marker.unfinished || (ForeignPaths(leftover, marker, &list_error).empty() &&
-                                    !list_error);
+        own = marker.unfinished ||
+              (ForeignPaths(leftover, marker, &list_error).empty() && !list_error);
       }
     } else if (fs::is_regular_file(status) && is_file) {
       // A staging file holds no marker, and a half-written one is not parsed (libhdf5 may crash

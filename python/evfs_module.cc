@@ -363,12 +363,12 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   request.method = settings.request.method;
   request.denoise = settings.request.denoise;
   // What --resume compares: everything that decides the frames (not jobs, resume, overwrite).
-  request.settings = std::string(py::str(ReconstructOptionValues(settings))) +
-                     " first=" + std::to_string(request.windows.first) +
-                     " last=" + std::to_string(request.windows.last) + " fps=" + std::to_string(fps) +
-                     " frame_step=" + std::to_string(request.windows.frame_step) +
-                     " predict_tail=" + std::to_string(predict_tail) +
-                     " preview=" + std::to_string(preview);
+  request.settings =
+      std::string(py::str(ReconstructOptionValues(settings))) +
+      " first=" + std::to_string(request.windows.first) +
+      " last=" + std::to_string(request.windows.last) + " fps=" + std::to_string(fps) +
+      " frame_step=" + std::to_string(request.windows.frame_step) +
+      " predict_tail=" + std::to_string(predict_tail) + " preview=" + std::to_string(preview);
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
   OutputOptions output;

@@ -109,13 +109,12 @@ TEST(EvfsFailure, BadSolverAndFrameFlagsNameTheFlag) {
   const fs::path out = scratch / "out";
   const std::string data = WriteSyntheticFolder(scratch.string());
   const std::string reconstruct =
-      "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=1 --out=" +
-      out.string();
+      "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=1 --out=" + out.string();
   ExpectUserError(RunEvfs(reconstruct + " --alpha=1e308"), "--alpha must be at most 1e6", out);
   ExpectUserError(RunEvfs(reconstruct + " --threads=0"), "--threads must be 1 or more", out);
-  ExpectUserError(RunEvfs("reconstruct --data=" + data + " --mode=predict --first=-5 --out=" +
-                          out.string()),
-                  "--first=-5: a frame number must be 0 or more", out);
+  ExpectUserError(
+      RunEvfs("reconstruct --data=" + data + " --mode=predict --first=-5 --out=" + out.string()),
+      "--first=-5: a frame number must be 0 or more", out);
   const std::string video = "video --data=" + data + " --out=" + out.string();
   ExpectUserError(RunEvfs(video + " --first=-5"), "--first=-5: a frame number must be 0 or more",
                   out);
@@ -168,16 +167,15 @@ TEST(EvfsFailure, FramePathsOutsideTheRecordingNeedAFlag) {
   std::string list = test::ReadFile(images_txt);
   const std::string first = "images/frame_0.png";
   fs::copy_file(data / first, scratch / "outside.png");
-  for (const std::string& outside : {std::string("../outside.png"),
-                                     (scratch / "outside.png").string()}) {
+  for (const std::string& outside :
+       {std::string("../outside.png"), (scratch / "outside.png").string()}) {
     SCOPED_TRACE(outside);
     std::string changed = list;
     changed.replace(changed.find(first), first.size(), outside);
     test::WriteFile(images_txt.string(), changed);
     for (const std::string& command :
          {"info --data=" + data.string(),
-          "reconstruct --data=" + data.string() + " --mode=predict --first=0 --out=" +
-              out.string(),
+          "reconstruct --data=" + data.string() + " --mode=predict --first=0 --out=" + out.string(),
           "convert --data=" + data.string() + " --out=" + out.string()}) {
       SCOPED_TRACE(command);
       ExpectUserError(RunEvfs(command), images_txt.string() + ":1", out);

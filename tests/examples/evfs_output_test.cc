@@ -243,9 +243,9 @@ TEST(EvfsOutput, ASymlinkedMarkerIsNamedAsOne) {
   fs::create_directories(out);
   test::WriteFile((sandbox.root / "thesis/marker").string(), "evfs simulate\n");
   fs::create_symlink(sandbox.root / "thesis/marker", out / kOutputMarkerFile);
-  ExpectRefused(sandbox.Run("simulate --frames=" + sandbox.data + " --out=" + out.string() +
-                            " --overwrite"),
-                "is a symbolic link");
+  ExpectRefused(
+      sandbox.Run("simulate --frames=" + sandbox.data + " --out=" + out.string() + " --overwrite"),
+      "is a symbolic link");
   EXPECT_TRUE(fs::is_symlink(out / kOutputMarkerFile));
   ExpectNoStagingLeft(out);
 }

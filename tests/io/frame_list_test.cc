@@ -105,8 +105,9 @@ TEST(ReadFrameListTest, PathsLeavingTheFolderAreRefusedUnlessAllowed) {
 
 // Some Windows editors start a UTF-8 file with a byte-order mark; it is no part of the first path.
 TEST(ReadFrameListTest, AByteOrderMarkIsSkipped) {
-  const std::string path =
-      TextFile("frames_bom", "images.txt", "\xEF\xBB\xBF" "1.5 images/a.png\n2.5 images/b.png\n");
+  const std::string path = TextFile("frames_bom", "images.txt",
+                                    "\xEF\xBB\xBF"
+                                    "1.5 images/a.png\n2.5 images/b.png\n");
   const std::vector<FrameInfo> frames = ReadFrameList(path);
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[0].t_ns, 1500000000);

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <filesystem>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -89,7 +88,11 @@ std::string PngHeader(uint32_t width, uint32_t height) {
 
 // SOI, an APP0 segment, then a baseline SOF0 declaring `width` x `height`.
 std::string JpegHeader(uint16_t width, uint16_t height) {
-  std::string bytes("\xff\xd8\xff\xe0\0\x04" "ab" "\xff\xc0\0\x0b\x08", 13);
+  std::string bytes(
+      "\xff\xd8\xff\xe0\0\x04"
+      "ab"
+      "\xff\xc0\0\x0b\x08",
+      13);
   for (const uint16_t side : {height, width}) {
     bytes.push_back(static_cast<char>(side >> 8));
     bytes.push_back(static_cast<char>(side & 0xff));
