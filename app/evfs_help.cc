@@ -125,6 +125,7 @@ ProgramHelp MakeEvfsHelp() {
       {"blur_from_data", "data", "video"},
       {"frame_step", "data", "video"},
       {"skip_bad_frames", "data", "video"},
+      {"allow_outside_paths", "data", "info reconstruct convert video simulate"},
       // The event simulator.
       {"threshold_pos", "simulator", "simulate"},
       {"threshold_neg", "simulator", "simulate"},

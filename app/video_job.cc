@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -81,6 +82,61 @@ bool IsOwnWorkFolder(const fs::path& folder) {
   return title == kWorkMarkerTitle;
 }
 
+// Whether `relative` (inside a work folder, '/'-separated) is a path a video run writes there:
+// the marker, frames/ and windows/ with their files, and each file's temporary name.
+bool IsWorkFolderPath(const std::string& relative, bool is_folder) {
+  if (is_folder) return relative == "frames" || relative == "windows";
+  static const std::regex kOwnFile(
+      R"((\.evfs-video-work|frames/[0-9]+(\.tmp)?\.png|windows/[0-9]+\.json)(\.tmp)?)");
+  return std::regex_match(relative, kOwnFile);
+}
+
+// The paths in a work folder that a video run does not write ("REL", "REL/" for a folder),
+// and the own files when `own_files` is given. Links are listed, never followed.
+std::vector<std::string> WorkFolderForeign(const fs::path& folder,
+                                           std::vector<fs::path>* own_files = nullptr) {
+  std::vector<std::string> foreign;
+  std::error_code error;
+  fs::recursive_directory_iterator it(folder, fs::directory_options::none, error);
+  for (; !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
+    const std::string relative = it->path().lexically_relative(folder).generic_string();
+    std::error_code status_error;
+    const fs::file_status status = it->symlink_status(status_error);
+    const bool is_folder = fs::is_directory(status);
+    if (IsWorkFolderPath(relative, is_folder) && (is_folder || fs::is_regular_file(status))) {
+      if (!is_folder && own_files != nullptr) own_files->push_back(it->path());
+      continue;
+    }
+    foreign.push_back(relative + (is_folder ? "/" : ""));
+    if (is_folder) it.disable_recursion_pending();
+  }
+  std::sort(foreign.begin(), foreign.end());
+  if (error) foreign.push_back("(a folder that cannot be listed: " + error.message() + ")");
+  return foreign;
+}
+
+// Removes what a video run wrote in its work folder, and the folder when nothing else is left
+// in it: what the user put there stays.
+void RemoveWorkFolder(const fs::path& folder) {
+  std::vector<fs::path> own_files;
+  std::error_code error;
+  if (WorkFolderForeign(folder, &own_files).empty()) {
+    fs::remove_all(folder, error);
+    return;
+  }
+  for (const fs::path& file : own_files) fs::remove(file, error);
+  for (const char* sub : {"frames", "windows", ""}) fs::remove(folder / sub, error);  // if empty
+}
+
+// "a, b, c (and 4 more)".
+std::string NameSome(const std::vector<std::string>& paths) {
+  constexpr size_t kNamed = 3;
+  std::string names;
+  for (size_t i = 0; i < paths.size() && i < kNamed; ++i) names += (i > 0 ? ", " : "") + paths[i];
+  if (paths.size() > kNamed) names += " (and " + std::to_string(paths.size() - kNamed) + " more)";
+  return names;
+}
+
 // Makes the work folder ready and returns the records of the windows it already holds (only
 // with `resume`, and only when the settings match).
 std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string& fingerprint,
@@ -91,6 +147,16 @@ std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string&
     throw InvalidArgumentError(folder.string() +
                                " exists and is not an evfs video work folder: evfs keeps "
                                "unfinished windows there; move it away");
+  }
+  if (exists) {
+    // A work folder is reused or replaced whole: nothing the user added may be mixed in or lost.
+    const std::vector<std::string> foreign = WorkFolderForeign(folder);
+    if (!foreign.empty()) {
+      throw InvalidArgumentError(folder.string() +
+                                 " (the work folder of this video) holds what "
+                                 "evfs did not write: " +
+                                 NameSome(foreign) + "; move that away");
+    }
   }
   const std::string marker_text = std::string(kWorkMarkerTitle) + "\n" + fingerprint;
   std::map<int, Json> done;
@@ -400,7 +466,8 @@ void WritePreview(const std::vector<VideoWindow>& windows, const SharedSource& s
 bool VideoRequest::IsValid(std::string* error) const {
   OptionChecker check;
   check.Valid(windows)
-      .Require(std::isfinite(fps) && fps >= 0.0, "--fps", "a number of frames per second >= 0")
+      .Require(std::isfinite(fps) && (fps == 0.0 || fps >= kMinVideoFps), "--fps",
+               "0 (derived) or at least 1 frame per second")
       .InRange("--jobs", jobs, 0, 4096)
       .InRange("--threads", threads_per_window, 0, 4096)
       .Valid(method.reconstruction)
@@ -417,8 +484,7 @@ std::string VideoWorkFolder(const std::string& out_path) {
 
 void RemoveVideoWorkFolder(const std::string& out_path) {
   const fs::path folder = VideoWorkFolder(out_path);
-  std::error_code error;
-  if (IsOwnWorkFolder(folder)) fs::remove_all(folder, error);
+  if (IsOwnWorkFolder(folder)) RemoveWorkFolder(folder);
 }
 
 std::string VideoProgressLine(const VideoProgress& progress) {
@@ -546,8 +612,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
     fs::path folder;
     bool armed = true;
     ~RemoveOnError() {
-      std::error_code ignored;
-      if (armed) fs::remove_all(folder, ignored);
+      if (armed && IsOwnWorkFolder(folder)) RemoveWorkFolder(folder);
     }
   } remove_on_error{work, !worker};
   for (auto it = records.begin(); it != records.end();) {

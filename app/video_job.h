@@ -39,6 +39,10 @@ namespace evfs {
 /// for (a DAVIS frame every 20–50 ms becomes a 200–500 fps video).
 inline constexpr double kDefaultUpsampling = 10.0;
 
+/// Slowest output rate: the MP4 encoder keeps the rate as a fraction with a small denominator
+/// and refuses rates near 0, and a video that upsamples frames is never slower than 1 fps.
+inline constexpr double kMinVideoFps = 1.0;
+
 /// Where a video job stands, after each window.
 struct VideoProgress {
   int windows_done = 0;  // including resumed ones

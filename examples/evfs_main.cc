@@ -47,6 +47,7 @@
 #include "events/simulator.h"
 #include "io/aedat4.h"
 #include "io/data_source.h"
+#include "io/frame_list.h"
 #include "io/hdf5_io.h"
 #include "io/output_target.h"
 #include "io/text_folder.h"
@@ -271,6 +272,9 @@ DEFINE_int32(frame_step, 1,
              "every frame.");
 DEFINE_bool(skip_bad_frames, false,
             "video: leave out missing or unreadable frames and reconstruct across the gap.");
+DEFINE_bool(allow_outside_paths, false,
+            "read frames that images.txt names outside the recording's folder (absolute paths, "
+            "'..').");
 // Simulator.
 DEFINE_double(threshold_pos, evfs::SimulatorOptions().contrast_threshold_pos,
               "simulate: ON contrast threshold (log intensity).");
@@ -481,6 +485,8 @@ int RunDenoise() {
 int RunReconstruct(ProgressReporter* progress) {
   Require(!FLAGS_data.empty(), "reconstruct needs --data=DIR or --data=FILE.h5");
   Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
+  Require(FLAGS_first >= -1,
+          "--first=" + std::to_string(FLAGS_first) + ": a frame number must be 0 or more");
   Require(FLAGS_first >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
   ReconstructRequest request = RequestFromFlags();
   OutputTarget out(OutputFromFlags("reconstruct", FLAGS_data));
@@ -519,7 +525,10 @@ std::string VideoSettings() {
 int RunVideoCommand(ProgressReporter* progress) {
   Require(!FLAGS_data.empty(), "video needs --data=DIR or --data=FILE.h5");
   Require(!FLAGS_out.empty(), "video needs --out=DIR");
-  Require(FLAGS_first >= -1 && FLAGS_last >= -1, "--first and --last must be frame numbers");
+  Require(FLAGS_first >= -1,
+          "--first=" + std::to_string(FLAGS_first) + ": a frame number must be 0 or more");
+  Require(FLAGS_last >= -1,
+          "--last=" + std::to_string(FLAGS_last) + ": a frame number must be 0 or more");
   const ReconstructRequest reconstruct = RequestFromFlags(/*with_mode=*/false);
   VideoRequest request;
   request.data_path = FLAGS_data;
@@ -620,6 +629,7 @@ int RunVideoCommand(ProgressReporter* progress) {
 }
 
 int RunCommand(const std::string& command) {
+  SetFramePathsMayLeaveFolder(FLAGS_allow_outside_paths);
   Require(std::isfinite(FLAGS_progress_interval_s) && FLAGS_progress_interval_s >= 0.0,
           "--progress_interval_s must be a number of seconds, 0 or more");
   // Lines on stderr while the command runs, only when it runs long (app/progress.h).

@@ -1,7 +1,9 @@
 #include "io/frame_list.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -16,6 +18,23 @@ namespace {
 
 // PATH_MAX on Linux: the system opens no longer path.
 constexpr size_t kMaxImagePathBytes = 4096;
+
+std::atomic<bool> frame_paths_may_leave_folder{false};
+
+// Why `path`, relative to the folder of images.txt, leads outside it, or "" when it stays in.
+// Decided on the text alone: a link inside the folder (images/ on another disk) is the user's
+// own arrangement.
+std::string OutsidePathProblem(const std::string& path) {
+  const std::filesystem::path given(path);
+  if (given.is_absolute()) {
+    return "frame path '" + MessageExcerpt(path) + "' is absolute";
+  }
+  const std::filesystem::path normal = given.lexically_normal();
+  if (!normal.empty() && *normal.begin() == "..") {
+    return "frame path '" + MessageExcerpt(path) + "' leads outside the recording's folder";
+  }
+  return "";
+}
 
 bool IsBlank(char c) { return c == ' ' || c == '\t'; }
 
@@ -41,8 +60,13 @@ std::ifstream OpenForReading(const std::string& path) {
 // the content trimmed of surrounding blanks and a trailing '\r'.
 void ForEachContentLine(std::istream& stream,
                         const std::function<void(int64_t, const std::string&)>& visit) {
+  // A UTF-8 byte-order mark, which some Windows editors put first, is no part of the text.
+  static const std::string kByteOrderMark = "\xEF\xBB\xBF";
   std::string line;
   for (int64_t line_number = 1; std::getline(stream, line); ++line_number) {
+    if (line_number == 1 && line.compare(0, kByteOrderMark.size(), kByteOrderMark) == 0) {
+      line.erase(0, kByteOrderMark.size());
+    }
     const std::string content = Trim(line);
     if (content.empty() || content[0] == '#') continue;
     visit(line_number, content);
@@ -88,6 +112,10 @@ bool SplitLast(const std::string& content, std::string* rest, std::string* last)
 
 }  // namespace
 
+void SetFramePathsMayLeaveFolder(bool allow) { frame_paths_may_leave_folder = allow; }
+
+bool FramePathsMayLeaveFolder() { return frame_paths_may_leave_folder; }
+
 std::string ImagePathProblem(const std::string& path) {
   if (HasControlCharacter(path)) {
     return "image path '" + MessageExcerpt(path) + "' holds a control character";
@@ -117,6 +145,13 @@ std::vector<FrameInfo> ReadFrameList(std::istream& stream, const std::string& im
     const std::string path_problem = ImagePathProblem(frame.path);
     if (!path_problem.empty()) {
       throw InputError(InputError::Kind::kMalformed, images_txt, line_number, path_problem);
+    }
+    if (!FramePathsMayLeaveFolder()) {
+      const std::string outside = OutsidePathProblem(frame.path);
+      if (!outside.empty()) {
+        throw InputError(InputError::Kind::kMalformed, images_txt, line_number,
+                         outside + "; pass --allow_outside_paths to read it");
+      }
     }
     frame.t_ns = ParseSecondsField(t_token, "t", images_txt, line_number);
     if (!frames.empty() && frame.t_ns <= frames.back().t_ns) {

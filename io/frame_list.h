@@ -12,8 +12,16 @@
 
 namespace evfs {
 
+/// Whether a frame path in images.txt may lead outside the folder that holds it (an absolute
+/// path, or one that climbs out with ".."). No by default: a recording names its own frames,
+/// and a list that reaches elsewhere reads files the user did not hand to evfs. Process-wide,
+/// set once by the CLI from --allow_outside_paths before any recording is opened.
+void SetFramePathsMayLeaveFolder(bool allow);
+bool FramePathsMayLeaveFolder();
+
 /// Reads images.txt. Timestamps must increase strictly (kNotMonotonic otherwise) and paths must
-/// be unique and usable (ImagePathProblem). Throws InputError naming the file and line.
+/// be unique and usable (ImagePathProblem), and stay inside the folder of images.txt unless
+/// FramePathsMayLeaveFolder(). Throws InputError naming the file and line.
 std::vector<FrameInfo> ReadFrameList(const std::string& images_txt);
 /// The same from `stream`, named `images_txt` in errors (for text already in memory).
 std::vector<FrameInfo> ReadFrameList(std::istream& stream, const std::string& images_txt);

@@ -40,9 +40,6 @@ constexpr char kEvfs[] = "evfs";
 constexpr size_t kMaxImageNameBytes = 64;
 // Event coordinates are uint16, so no sensor side is longer.
 constexpr hsize_t kMaxImageSide = 65536;
-// Most pixels a sensor may have (8192 x 8192, far beyond any event camera's 1280 x 960): a
-// declared size is allocated for (frames, per-pixel counts), so it is bounded before it is.
-constexpr int64_t kMaxSensorPixels = int64_t{1} << 26;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
 
@@ -526,9 +523,16 @@ class Hdf5DataSource::File {
     if (H5Sget_simple_extent_npoints(space.get()) != 2)
       h5_.Fail(InputError::Kind::kMalformed, what + " must hold [height, width]");
     h5_.CheckStatus(H5Aread(attribute.get(), H5T_NATIVE_INT64, resolution), "unreadable " + what);
-    if (resolution[0] <= 0 || resolution[1] <= 0 || resolution[0] > 65536 ||
-        resolution[1] > 65536) {
+    if (resolution[0] <= 0 || resolution[1] <= 0) {
       h5_.Fail(InputError::Kind::kOutOfRange, what + " must hold a positive [height, width]");
+    }
+    if (resolution[0] > static_cast<int64_t>(kMaxImageSide) ||
+        resolution[1] > static_cast<int64_t>(kMaxImageSide)) {
+      h5_.Fail(InputError::Kind::kOutOfRange,
+               what + " declares a " + std::to_string(resolution[1]) + "x" +
+                   std::to_string(resolution[0]) + " sensor: beyond the " +
+                   std::to_string(kMaxImageSide) + " pixels a side and " +
+                   std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
     }
     CheckSensorPixels(what + " declares a", resolution[1], resolution[0]);
     height_ = static_cast<int>(resolution[0]);

@@ -1,8 +1,13 @@
 #include "io/image_io.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -51,12 +56,111 @@ void WritePng(const std::string& path, const cv::Mat& mat) {
     throw InputError(InputError::Kind::kUnwritable, path, 0, "cannot write the image: " + why);
 }
 
+// Big-endian unsigned integer of `bytes` bytes at `data`.
+int64_t BigEndian(const unsigned char* data, int bytes) {
+  int64_t value = 0;
+  for (int i = 0; i < bytes; ++i) value = (value << 8) | data[i];
+  return value;
+}
+
+// PNG: the signature, then the IHDR chunk, whose data opens with width and height (4 bytes
+// each, big-endian) at bytes 16..23 of the file (PNG specification, 11.2.2).
+bool PngHeaderSize(std::ifstream& file, int64_t* width, int64_t* height) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  unsigned char header[24];
+  file.seekg(0);
+  if (!file.read(reinterpret_cast<char*>(header), sizeof(header))) return false;
+  if (std::memcmp(header, kSignature, sizeof(kSignature)) != 0) return false;
+  if (std::memcmp(header + 12, "IHDR", 4) != 0) return false;
+  *width = BigEndian(header + 16, 4);
+  *height = BigEndian(header + 20, 4);
+  return true;
+}
+
+// Most bytes of JPEG segments skipped looking for the frame header: its SOF segment comes
+// before the image data, after the tables and metadata (EXIF at most 64 KiB a segment).
+constexpr int64_t kMaxJpegHeaderBytes = int64_t{16} << 20;
+
+// JPEG: the segments after SOI up to a start-of-frame marker (SOF0..SOF15 but DHT, JPG and
+// DAC), whose data holds precision, height and width (ITU T.81, B.2.2).
+bool JpegHeaderSize(std::ifstream& file, int64_t* width, int64_t* height) {
+  unsigned char soi[2];
+  file.seekg(0);
+  if (!file.read(reinterpret_cast<char*>(soi), 2) || soi[0] != 0xFF || soi[1] != 0xD8) {
+    return false;
+  }
+  while (file.tellg() < kMaxJpegHeaderBytes) {
+    unsigned char marker[2];
+    if (!file.read(reinterpret_cast<char*>(marker), 2) || marker[0] != 0xFF) return false;
+    if (marker[1] == 0xFF) {  // fill byte
+      file.seekg(-1, std::ios::cur);
+      continue;
+    }
+    unsigned char length_bytes[2];
+    if (!file.read(reinterpret_cast<char*>(length_bytes), 2)) return false;
+    const int64_t length = BigEndian(length_bytes, 2);
+    if (length < 2) return false;
+    const unsigned char code = marker[1];
+    if (code >= 0xC0 && code <= 0xCF && code != 0xC4 && code != 0xC8 && code != 0xCC) {
+      unsigned char frame[5];
+      if (!file.read(reinterpret_cast<char*>(frame), 5)) return false;
+      *height = BigEndian(frame + 1, 2);
+      *width = BigEndian(frame + 3, 2);
+      return true;
+    }
+    file.seekg(length - 2, std::ios::cur);
+  }
+  return false;
+}
+
 }  // namespace
 
-Image ReadGreyImage(const std::string& path) {
+bool ReadImageHeaderSize(const std::string& path, int64_t* width, int64_t* height) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return false;
+  if (PngHeaderSize(file, width, height)) return true;
+  file.clear();
+  return JpegHeaderSize(file, width, height);
+}
+
+Image ReadGreyImage(const std::string& path, int expected_width, int expected_height,
+                    const std::string& expected_what) {
+  // What stands at the path is named: a folder, a FIFO or a file without read permission is
+  // not a missing file, and none of them an undecodable one.
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (!std::filesystem::exists(status)) {
     throw InputError(InputError::Kind::kMissingFile, path, 0, "image file does not exist");
+  }
+  if (std::filesystem::is_directory(status)) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0, "a folder, not an image file");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0,
+                     "a FIFO, socket or device, not an image file");
+  }
+  if (::access(path.c_str(), R_OK) != 0) {
+    throw InputError(InputError::Kind::kMissingFile, path, 0,
+                     std::string("cannot read the image file: ") + std::strerror(errno));
+  }
+  const auto size_text = [](int64_t width, int64_t height) {
+    return std::to_string(width) + "x" + std::to_string(height);
+  };
+  // The declared size first: decoding allocates for it, whatever the file's own size.
+  int64_t width = 0, height = 0;
+  if (ReadImageHeaderSize(path, &width, &height)) {
+    if (expected_width > 0 && expected_height > 0 &&
+        (width != expected_width || height != expected_height)) {
+      throw InputError(
+          InputError::Kind::kSizeMismatch, path, 0,
+          "image is " + size_text(width, height) + ", expected " +
+              (expected_what.empty() ? size_text(expected_width, expected_height) : expected_what));
+    }
+    if (width * height > kMaxSensorPixels) {
+      throw InputError(InputError::Kind::kOutOfRange, path, 0,
+                       "image is " + size_text(width, height) + ": more than the " +
+                           std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
+    }
   }
   cv::Mat mat;
   try {

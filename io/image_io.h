@@ -10,10 +10,23 @@
 
 namespace evfs {
 
+/// Most pixels a sensor, and so a frame, may have (8192 x 8192, far beyond any event camera's
+/// 1280 x 960): a declared size is allocated for (frames, per-pixel counts), so every reader
+/// bounds it before it allocates.
+inline constexpr int64_t kMaxSensorPixels = int64_t{1} << 26;
+
+/// The width and height an image file declares in its header (PNG, JPEG), read without
+/// decoding it. False for another format, or a header too short to hold them.
+bool ReadImageHeaderSize(const std::string& path, int64_t* width, int64_t* height);
+
 /// Reads an 8- or 16-bit image (colour is converted to grey) scaled to [0, 1]: 8-bit values are
-/// divided by 255, 16-bit ones by 65535. Throws InputError(kMissingFile) when the file is
-/// missing or cannot be decoded.
-Image ReadGreyImage(const std::string& path);
+/// divided by 255, 16-bit ones by 65535. The size its header declares is checked before any
+/// pixel is decoded: more than kMaxSensorPixels is InputError(kOutOfRange), and when
+/// `expected_width` and `expected_height` are not 0, another size is
+/// InputError(kSizeMismatch) ("expected `expected_what`", which names the size). Throws
+/// InputError(kMissingFile) when the file is missing or cannot be decoded.
+Image ReadGreyImage(const std::string& path, int expected_width = 0, int expected_height = 0,
+                    const std::string& expected_what = "");
 
 /// The fewest bits per pixel (8 or 16) that hold `image` exactly as ReadGreyImage returns it:
 /// 8 when every value is k / 255 for an integer k in [0, 255], else 16.

@@ -2,14 +2,20 @@
 
 #include <fcntl.h>
 #include <pwd.h>
+#include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <sstream>
 
 #include "core/error.h"
 #include "io/signal_cleanup.h"
@@ -28,8 +34,16 @@ constexpr char kStagingTag[] = ".evfs-tmp-";
 constexpr char kAsideTag[] = ".evfs-old-";
 // Digits a process id and a retry counter take in those names.
 constexpr size_t kUniqueDigits = 24;
-// Most bytes of a marker file read back: its one line is "evfs <command>".
-constexpr std::streamsize kMaxMarkerBytes = 256;
+// Most bytes of a marker file read back: its first line and one line per path evfs wrote
+// (a long video's frames take a few hundred kilobytes).
+constexpr std::streamsize kMaxMarkerBytes = 64 << 20;
+// Foreign paths a refusal names before it says how many more there are.
+constexpr size_t kForeignPathsNamed = 3;
+// The marker's lines after the first: "folder REL" and "file REL" for each path evfs wrote, and
+// kUnfinishedLine in a staging folder, whose whole content is evfs's work in progress.
+constexpr char kFolderEntry[] = "folder ";
+constexpr char kFileEntry[] = "file ";
+constexpr char kUnfinishedLine[] = "unfinished";
 
 // Absolute, normalised, without a trailing separator: "out/", "./out" and "out" are one path.
 fs::path Normalized(const std::string& path) {
@@ -61,18 +75,125 @@ bool IsSameOrInside(const fs::path& inner, const fs::path& outer) {
   return true;
 }
 
-// The command an output folder's marker names ("evfs reconstruct"), or "" without a readable
-// marker. Only a regular file is read: a FIFO named like the marker must not block.
-std::string ReadMarker(const fs::path& folder) {
-  const fs::path marker = folder / kOutputMarkerFile;
+// An output folder's marker as read back.
+struct Marker {
+  enum class State { kMissing, kSymlink, kNotAFile, kUnreadable, kRead };
+  State state = State::kMissing;
+  std::string command;            // its first line: "evfs reconstruct"
+  std::set<std::string> entries;  // "folder frames", "file frames/000000.png"
+  bool unfinished = false;        // a staging folder's marker
+};
+
+// The marker of `folder`. Only a regular file is read: a FIFO named like the marker must not
+// block, and a link could make a folder of the user's look like evfs's.
+Marker ReadMarker(const fs::path& folder) {
+  const fs::path path = folder / kOutputMarkerFile;
+  Marker marker;
   std::error_code error;
-  if (!fs::is_regular_file(fs::symlink_status(marker, error))) return "";
-  std::ifstream in(marker);
-  std::string line(kMaxMarkerBytes, '\0');
-  in.read(line.data(), kMaxMarkerBytes);
-  line.resize(static_cast<size_t>(in.gcount()));
-  const size_t end = line.find('\n');
-  return end == std::string::npos ? "" : line.substr(0, end);
+  const fs::file_status status = fs::symlink_status(path, error);
+  if (!fs::exists(status)) return marker;
+  if (fs::is_symlink(status)) {
+    marker.state = Marker::State::kSymlink;
+    return marker;
+  }
+  if (!fs::is_regular_file(status)) {
+    marker.state = Marker::State::kNotAFile;
+    return marker;
+  }
+  std::ifstream in(path);
+  std::string text(kMaxMarkerBytes + 1, '\0');
+  in.read(text.data(), kMaxMarkerBytes + 1);
+  text.resize(static_cast<size_t>(in.gcount()));
+  marker.state = Marker::State::kUnreadable;
+  if (in.bad() || text.size() > static_cast<size_t>(kMaxMarkerBytes)) return marker;
+  const size_t end = text.find('\n');
+  if (end == std::string::npos) return marker;
+  marker.state = Marker::State::kRead;
+  marker.command = text.substr(0, end);
+  std::istringstream lines(text.substr(end + 1));
+  for (std::string line; std::getline(lines, line);) {
+    if (line == kUnfinishedLine) {
+      marker.unfinished = true;
+    } else if (!line.empty()) {
+      marker.entries.insert(line);
+    }
+  }
+  return marker;
+}
+
+// The marker's line for `relative`, the path of `status` inside the folder.
+std::string EntryLine(const fs::file_status& status, const std::string& relative) {
+  return (fs::is_directory(status) ? kFolderEntry : kFileEntry) + relative;
+}
+
+// Every path inside `folder` but its marker, as marker lines, in a stable order. Links are
+// listed, never followed. Sets `error` when a folder cannot be listed.
+std::vector<std::string> ListEntries(const fs::path& folder, std::error_code* error) {
+  std::vector<std::string> entries;
+  fs::recursive_directory_iterator it(folder, fs::directory_options::none, *error);
+  for (; !*error && it != fs::recursive_directory_iterator(); it.increment(*error)) {
+    const std::string relative = it->path().lexically_relative(folder).generic_string();
+    if (relative == kOutputMarkerFile) continue;
+    std::error_code status_error;
+    entries.push_back(EntryLine(it->symlink_status(status_error), relative));
+  }
+  std::sort(entries.begin(), entries.end());
+  return entries;
+}
+
+// The paths inside `folder` that its marker does not list, each as "REL" ("REL/" for a folder,
+// whose content is then not listed). Sets `error` when a folder cannot be listed.
+std::vector<std::string> ForeignPaths(const fs::path& folder, const Marker& marker,
+                                      std::error_code* error) {
+  std::vector<std::string> foreign;
+  fs::recursive_directory_iterator it(folder, fs::directory_options::none, *error);
+  for (; !*error && it != fs::recursive_directory_iterator(); it.increment(*error)) {
+    const std::string relative = it->path().lexically_relative(folder).generic_string();
+    if (relative == kOutputMarkerFile) continue;
+    std::error_code status_error;
+    const fs::file_status status = it->symlink_status(status_error);
+    if (marker.entries.count(EntryLine(status, relative)) != 0) continue;
+    const bool is_folder = fs::is_directory(status);
+    foreign.push_back(relative + (is_folder ? "/" : ""));
+    if (is_folder) it.disable_recursion_pending();
+  }
+  std::sort(foreign.begin(), foreign.end());
+  return foreign;
+}
+
+// "a, b, c (and 4 more)".
+std::string NameSome(const std::vector<std::string>& paths) {
+  std::string names;
+  for (size_t i = 0; i < paths.size() && i < kForeignPathsNamed; ++i) {
+    names += (i > 0 ? ", " : "") + paths[i];
+  }
+  if (paths.size() > kForeignPathsNamed) {
+    names += " (and " + std::to_string(paths.size() - kForeignPathsNamed) + " more)";
+  }
+  return names;
+}
+
+// Removes a tree evfs wrote. Folders made read-only (a user protecting frames/) would stop
+// the removal of their content, so each folder is made writable by its owner first.
+void RemoveOwnTree(const fs::path& path, std::error_code* error) {
+  fs::remove_all(path, *error);
+  if (!*error) return;
+  std::error_code walk_error;
+  fs::permissions(path, fs::perms::owner_all, fs::perm_options::add, walk_error);
+  for (fs::recursive_directory_iterator it(path, fs::directory_options::none, walk_error);
+       !walk_error && it != fs::recursive_directory_iterator(); it.increment(walk_error)) {
+    std::error_code status_error;
+    if (fs::is_directory(it->symlink_status(status_error))) {
+      fs::permissions(it->path(), fs::perms::owner_all, fs::perm_options::add, status_error);
+    }
+  }
+  error->clear();
+  fs::remove_all(path, *error);
+}
+
+void DefaultWarn(const std::string& message) {
+  std::fprintf(stderr, "evfs: %s\n", message.c_str());
+  std::fflush(stderr);
 }
 
 std::string MarkerLine(const std::string& command) { return "evfs " + command; }
@@ -94,6 +215,38 @@ fs::path TaggedSibling(const fs::path& path, const char* tag, bool keep_extensio
                      : "." + path.filename().string() + tag + unique;
   return path.parent_path() / name;
 }
+
+// The process id in `name` when it is a staging or aside name of `path` (TaggedSibling),
+// else 0.
+pid_t TaggedSiblingPid(const fs::path& path, const std::string& name, bool keep_extension) {
+  for (const char* tag : {kStagingTag, kAsideTag}) {
+    const std::string prefix =
+        "." + (keep_extension ? path.stem().string() : path.filename().string()) + tag;
+    const std::string suffix = keep_extension ? path.extension().string() : "";
+    if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+      continue;
+    }
+    const std::string unique =
+        name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    const size_t dash = unique.find('-');
+    if (dash == 0 || dash == std::string::npos || dash + 1 == unique.size() ||
+        dash > kUniqueDigits) {
+      continue;
+    }
+    const auto digits = [](const std::string& text) {
+      return std::all_of(text.begin(), text.end(),
+                         [](unsigned char c) { return std::isdigit(c) != 0; });
+    };
+    if (!digits(unique.substr(0, dash)) || !digits(unique.substr(dash + 1))) continue;
+    const long long pid = std::atoll(unique.substr(0, dash).c_str());
+    if (pid > 0 && pid <= INT_MAX) return static_cast<pid_t>(pid);
+  }
+  return 0;
+}
+
+// True when process `pid` runs on this machine (or may: one we may not signal).
+bool ProcessRuns(pid_t pid) { return ::kill(pid, 0) == 0 || errno != ESRCH; }
 
 }  // namespace
 
@@ -168,6 +321,8 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
                          " bytes, the system allows " + std::to_string(PATH_MAX) + ")");
   }
 
+  RemoveLeftovers();
+
   // Nothing has been read or computed yet: create the parents and the staging path now, so an
   // output that cannot be written fails before the work.
   for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
@@ -195,6 +350,11 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
     } else {
       created = fs::create_directory(staging, error) && !error;
       open_errno = error.value();
+    }
+    if (created && !is_file) {
+      // Marked at once, so that a later run knows a folder left by a killed one as evfs's.
+      std::ofstream marker(staging / kOutputMarkerFile);
+      marker << MarkerLine(options_.command) << "\n" << kUnfinishedLine << "\n";
     }
     if (created) break;
     cleanup_.reset();
@@ -233,13 +393,37 @@ void OutputTarget::CheckExisting() const {
       Refuse(path, "it exists and is not a folder ('" + command + "' writes a folder)");
     }
     if (fs::is_empty(path, error) && !error) return;
-    const std::string marker = ReadMarker(path);
-    if (marker.empty()) {
-      Refuse(path, "the folder holds files evfs did not write (it has no " +
-                       std::string(kOutputMarkerFile) + "); name a new folder");
+    const Marker marker = ReadMarker(path);
+    const std::string marker_name = std::string(kOutputMarkerFile);
+    switch (marker.state) {
+      case Marker::State::kMissing:
+        Refuse(path, "the folder holds files evfs did not write (it has no " + marker_name +
+                         "); name a new folder");
+      case Marker::State::kSymlink:
+        Refuse(path, "its " + marker_name +
+                         " is a symbolic link, not a marker evfs wrote; name a new folder");
+      case Marker::State::kNotAFile:
+        Refuse(path, "its " + marker_name +
+                         " is not a regular file, so not a marker evfs wrote; name a new folder");
+      case Marker::State::kUnreadable:
+        Refuse(path, "its " + marker_name + " cannot be read as evfs's marker; name a new folder");
+      case Marker::State::kRead:
+        break;
     }
-    if (marker != command) {
-      Refuse(path, "the folder holds the output of '" + marker + "', not of '" + command + "'");
+    if (marker.command != command) {
+      Refuse(path,
+             "the folder holds the output of '" + marker.command + "', not of '" + command + "'");
+    }
+    if (options_.overwrite) {
+      // --overwrite replaces what evfs wrote, never what the user added to it.
+      const std::vector<std::string> foreign = ForeignPaths(path, marker, &error);
+      if (error) {
+        Refuse(path, "cannot list the earlier output to replace it (" + error.message() + ")");
+      }
+      if (!foreign.empty()) {
+        Refuse(path, "the earlier output holds what evfs did not write: " + NameSome(foreign) +
+                         "; move that away or name a new folder");
+      }
     }
   } else {
     if (fs::is_directory(status)) {
@@ -261,8 +445,17 @@ void OutputTarget::Commit() {
   const fs::path path = path_;
   const bool is_file = options_.kind == OutputOptions::Kind::kFile;
   if (!is_file) {
-    std::ofstream marker(fs::path(staging_) / kOutputMarkerFile);
+    std::error_code list_error;
+    const std::vector<std::string> entries = ListEntries(staging_, &list_error);
+    if (list_error) {
+      Unwritable(staging_, "cannot list the new output (" + list_error.message() + ")");
+    }
+    std::ofstream marker(fs::path(staging_) / kOutputMarkerFile, std::ios::trunc);
     marker << MarkerLine(options_.command) << "\n";
+    // A name holding a line break cannot be listed; it is then foreign to a later --overwrite.
+    for (const std::string& entry : entries) {
+      if (entry.find('\n') == std::string::npos) marker << entry << "\n";
+    }
     marker.close();
     if (!marker) Unwritable(path / kOutputMarkerFile, "cannot write the output marker");
   }
@@ -281,7 +474,7 @@ void OutputTarget::Commit() {
   // output, which is removed next (still registered, so that it goes even if we die now).
   if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, path_.c_str(), RENAME_EXCHANGE) == 0) {
     committed_ = true;
-    fs::remove_all(staging_, error);
+    RemoveReplaced(staging_);
     cleanup_.reset();
     return;
   }
@@ -306,7 +499,66 @@ void OutputTarget::Commit() {
   }
   committed_ = true;
   cleanup_.reset();
-  fs::remove_all(aside, error);
+  RemoveReplaced(aside);
+}
+
+void OutputTarget::Warn(const std::string& message) const {
+  if (options_.warn) {
+    options_.warn(message);
+  } else {
+    DefaultWarn(message);
+  }
+}
+
+void OutputTarget::RemoveReplaced(const fs::path& replaced) const {
+  std::error_code error;
+  RemoveOwnTree(replaced, &error);
+  if (error) {
+    Warn("the earlier output of " + path_ + " was replaced but cannot be removed from " +
+         replaced.string() + " (" + error.message() + "); a later run on " + path_ + " removes it");
+  }
+}
+
+void OutputTarget::RemoveLeftovers() const {
+  const fs::path path = path_;
+  const bool is_file = options_.kind == OutputOptions::Kind::kFile;
+  std::error_code error;
+  std::vector<fs::path> leftovers;
+  for (fs::directory_iterator it(path.parent_path(), error);
+       !error && it != fs::directory_iterator(); it.increment(error)) {
+    const pid_t pid = TaggedSiblingPid(path, it->path().filename().string(), is_file);
+    if (pid != 0 && pid != ::getpid() && !ProcessRuns(pid)) leftovers.push_back(it->path());
+  }
+  for (const fs::path& leftover : leftovers) {
+    // Only what evfs shows to be its own goes: an empty folder or file, a staging folder (its
+    // marker says so), or an earlier output holding nothing but what its marker lists.
+    std::error_code status_error;
+    const fs::file_status status = fs::symlink_status(leftover, status_error);
+    bool own = false;
+    if (fs::is_directory(status)) {
+      const Marker marker = ReadMarker(leftover);
+      if (fs::is_empty(leftover, status_error) && !status_error) {
+        own = true;
+      } else if (marker.state == Marker::State::kRead && marker.command.rfind("evfs ", 0) == 0) {
+        std::error_code list_error;
+        own = marker.unfinished ||
+              (ForeignPaths(leftover, marker, &list_error).empty() && !list_error);
+      }
+    } else if (fs::is_regular_file(status) && is_file) {
+      // A staging file holds no marker, and a half-written one is not parsed (libhdf5 may crash
+      // on it): only an empty one is known to be evfs's.
+      own = fs::file_size(leftover, status_error) == 0 && !status_error;
+    }
+    if (!own) continue;
+    std::error_code remove_error;
+    RemoveOwnTree(leftover, &remove_error);
+    if (remove_error) {
+      Warn("cannot remove " + leftover.string() + ", left by an evfs run that ended early (" +
+           remove_error.message() + ")");
+    } else {
+      Warn("removed " + leftover.string() + ", left by an evfs run that ended early");
+    }
+  }
 }
 
 }  // namespace evfs

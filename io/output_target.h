@@ -6,8 +6,12 @@
 //   out.Commit();                          // marker, then the earlier output is replaced
 //
 // An output folder is marked as evfs's by OUT/.evfs-output, written last, which names the
-// command ("evfs reconstruct"). An existing OUT is replaced only when it is an empty folder, or
-// an earlier output of the same command and the user asked to overwrite it. A file output (an
+// command ("evfs reconstruct") and lists every path evfs wrote there. An existing OUT is
+// replaced only when it is an empty folder, or an earlier output of the same command that holds
+// nothing the marker does not list, and the user asked to overwrite it: what the user added to
+// an output is never deleted. A staging folder is marked at once as unfinished, so that one
+// left by a killed process (SIGKILL: nothing can clean up) is known as evfs's; a later run on
+// the same OUT removes such leftovers, and says so. A file output (an
 // .h5 file) is recognised by a predicate the caller gives (the HDF5 writer's own attribute).
 // Until Commit() the staging path is removed on every failure (the destructor) and when the
 // process dies (SIGINT, SIGTERM, SIGHUP, a crash: io/signal_cleanup.h); the earlier output stays
@@ -15,6 +19,7 @@
 #ifndef EVFS_IO_OUTPUT_TARGET_H_
 #define EVFS_IO_OUTPUT_TARGET_H_
 
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -51,6 +56,8 @@ struct OutputOptions {
   std::vector<ProtectedFolder> protected_folders = DefaultProtectedFolders();
   /// kFile: whether an existing file at OUT is an earlier output of this command.
   std::function<bool(const std::string& path)> is_own_file;
+  /// Where notes about leftovers go (one line each, no newline); empty: stderr, after "evfs: ".
+  std::function<void(const std::string& message)> warn;
 };
 
 class OutputTarget {
@@ -79,6 +86,12 @@ class OutputTarget {
  private:
   // Throws unless what is at path_ now may be replaced.
   void CheckExisting() const;
+  // Removes the staging and aside paths of path_ that a dead evfs process left, when evfs shows
+  // them to be its own, and says so through Warn.
+  void RemoveLeftovers() const;
+  // Removes an earlier output once replaced; warns when it cannot.
+  void RemoveReplaced(const std::filesystem::path& replaced) const;
+  void Warn(const std::string& message) const;
 
   OutputOptions options_;
   std::string path_;

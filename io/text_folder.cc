@@ -110,13 +110,13 @@ Image TextFolderDataSource::ReadImage(int index) const {
                                std::to_string(frames_.size()) + ")");
   }
   const std::string image_path = (fs::path(path_) / frames_[index].path).string();
-  Image image = ReadGreyImage(image_path);
+  const std::string expected = "the sensor size " + std::to_string(width_) + "x" +
+                               std::to_string(height_) + " of the first image";
+  Image image = ReadGreyImage(image_path, width_, height_, expected);
   if (image.cols() != width_ || image.rows() != height_) {
     throw InputError(InputError::Kind::kSizeMismatch, image_path, 0,
                      "image is " + std::to_string(image.cols()) + "x" +
-                         std::to_string(image.rows()) + ", expected the sensor size " +
-                         std::to_string(width_) + "x" + std::to_string(height_) +
-                         " of the first image");
+                         std::to_string(image.rows()) + ", expected " + expected);
   }
   return image;
 }

@@ -260,9 +260,24 @@ py::dict ReadArrays(const std::string& path) {
   return result;
 }
 
+// A Python int argument as a C++ int. One beyond int's range is a bad value like any other
+// (ValueError, naming the argument), not pybind11's TypeError of a failed conversion.
+int IntArgument(const py::int_& value, const char* name) {
+  int overflow = 0;
+  const long long number = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+  if (overflow != 0 || number < std::numeric_limits<int>::min() ||
+      number > std::numeric_limits<int>::max()) {
+    const std::string text = value.attr("__str__")().cast<std::string>();
+    throw InvalidArgumentError(std::string(name) + "=" + text +
+                               " is out of range: it must fit in 32 bits");
+  }
+  return static_cast<int>(number);
+}
+
 py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle events,
-                           const std::string& mode, int first, int last, int truth,
-                           py::handle exposures, py::handle options, const std::string& dtype) {
+                           const std::string& mode, const py::int_& first, const py::int_& last,
+                           const py::int_& truth, py::handle exposures, py::handle options,
+                           const std::string& dtype) {
   if (dtype != "float32" && dtype != "float64") {
     throw InvalidArgumentError("dtype must be 'float32' or 'float64', not '" + dtype + "'");
   }
@@ -272,9 +287,9 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   ReconstructRequest& request = settings.request;
   request.data_label = kArraysLabel;
   request.mode = ParseMode(mode);
-  request.first = first;
-  request.last = last;
-  request.truth = truth;
+  request.first = IntArgument(first, "first");
+  request.last = IntArgument(last, "last");
+  request.truth = IntArgument(truth, "truth");
 
   RecordingInput input;
   SetFrames(frames, &input);
@@ -327,31 +342,33 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
 // evfs.video: `evfs video` without MPI, into a folder through the same OutputTarget (so the
 // same refusals and the same atomic replacement). Unlike the command line it runs in this
 // process: a signal leaves the staging folder, and the resumable work folder, behind.
-py::dict VideoFromPath(const std::string& data, const std::string& out, int first, int last,
-                       double fps, int jobs, int frame_step, bool predict_tail, bool preview,
-                       bool resume, bool overwrite, py::handle options) {
+py::dict VideoFromPath(const std::string& data, const std::string& out, const py::int_& first,
+                       const py::int_& last, double fps, const py::int_& jobs,
+                       const py::int_& frame_step, bool predict_tail, bool preview, bool resume,
+                       bool overwrite, py::handle options) {
   ReconstructSettings settings = DefaultReconstructSettings();
   ApplyReconstructOptions(options, &settings);
   ResolveDenoise(&settings);
   VideoRequest request;
   request.data_path = data;
-  request.windows.first = first;
-  request.windows.last = last;
-  request.windows.frame_step = frame_step;
+  request.windows.first = IntArgument(first, "first");
+  request.windows.last = IntArgument(last, "last");
+  request.windows.frame_step = IntArgument(frame_step, "frame_step");
   request.windows.predict_tail = predict_tail;
   request.fps = fps;
-  request.jobs = jobs;
+  request.jobs = IntArgument(jobs, "jobs");
   request.preview = preview;
   request.resume = resume;
   request.binning = settings.request.binning;
   request.method = settings.request.method;
   request.denoise = settings.request.denoise;
   // What --resume compares: everything that decides the frames (not jobs, resume, overwrite).
-  request.settings = std::string(py::str(ReconstructOptionValues(settings))) +
-                     " first=" + std::to_string(first) + " last=" + std::to_string(last) +
-                     " fps=" + std::to_string(fps) + " frame_step=" + std::to_string(frame_step) +
-                     " predict_tail=" + std::to_string(predict_tail) +
-                     " preview=" + std::to_string(preview);
+  request.settings =
+      std::string(py::str(ReconstructOptionValues(settings))) +
+      " first=" + std::to_string(request.windows.first) +
+      " last=" + std::to_string(request.windows.last) + " fps=" + std::to_string(fps) +
+      " frame_step=" + std::to_string(request.windows.frame_step) +
+      " predict_tail=" + std::to_string(predict_tail) + " preview=" + std::to_string(preview);
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
   OutputOptions output;

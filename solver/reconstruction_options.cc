@@ -22,8 +22,8 @@ bool ObjectiveOptions::IsValid(std::string* error) const {
              "at least one term weight must be positive")
       .Check(std::isfinite(smoothing_scale) && smoothing_scale > 0.0,
              "smoothing_scale must be positive")
-      .Check(std::isfinite(event_model.alpha),
-             "alpha must be finite (<= 0 derives it from the data)")
+      .Check(std::isfinite(event_model.alpha) && event_model.alpha <= kMaxAlpha,
+             "--alpha must be at most 1e6 (<= 0 derives it from the data)")
       .Check(event_model.saturation == 0.0 ||
                  (std::isfinite(event_model.saturation) && event_model.saturation >= 1.0),
              "event_saturation (c of c tanh(alpha dg / c)) must be >= 1 (0 derives it)")
@@ -91,6 +91,7 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
              "step_ramp_px must be in [0, 1e6]")
       .Check(max_problem_mb <= kMaxProblemMb,
              "max_problem_mb must be at most " + std::to_string(kMaxProblemMb) + " (1 TiB)")
+      .Check(solver.num_threads >= 1, "--threads must be 1 or more")
       .Valid(solver);
   return check.Passed(error);
 }

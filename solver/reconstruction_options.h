@@ -24,6 +24,11 @@ namespace evfs {
 /// path length of a pixel's intensity do not grow with K), the spatial TV is a mean over frames
 /// (summed, it would blur more the more latent frames there are).
 struct ObjectiveOptions {
+  /// Largest event_model.alpha accepted. α is 1 / C for a contrast threshold C in log
+  /// intensity; 1e6 is a threshold thousands of times finer than any sensor's (0.1 to 0.5),
+  /// and far larger values overflow the event residuals and their derivatives.
+  static constexpr double kMaxAlpha = 1e6;
+
   /// Weight of the frame term (paper Eq. 3), per frame observation. Smaller weights let the
   /// events pull the frames away from what was observed (sweep: BENCHMARKS.md, "Where the
   /// defaults come from").

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "io/aedat4/format.h"
 #include "io/aedat4/io_header_generated.h"
+#include "io/image_io.h"
 #include "io/message_excerpt.h"
 
 namespace evfs {
@@ -50,6 +51,12 @@ class HeaderParser {
 
   Header Parse() {
     if (!StartsWith(data_, size_, kVersionLine, kVersionLineBytes)) {
+      if (size_ < kVersionLineBytes && size_ >= kAedatPrefixBytes &&
+          std::memcmp(data_, kVersionLine, size_) == 0) {
+        Fail(InputError::Kind::kMalformed, "truncated inside the version line (" +
+                                               std::to_string(size_) + " of its " +
+                                               std::to_string(kVersionLineBytes) + " bytes)");
+      }
       if (StartsWith(data_, size_, kAedatPrefix, kAedatPrefixBytes)) {
         const size_t shown = std::min<size_t>(size_, kAedatPrefixBytes + 3);
         Fail(InputError::Kind::kMalformed,
@@ -191,8 +198,16 @@ class HeaderParser {
              "stream description: " + where + "gives only one of sizeX and sizeY");
       }
       if (size_x != nullptr) {
-        stream->size_x = static_cast<int>(ParseInteger(size_x, where + "sizeX", 1, kMaxSensorSide));
-        stream->size_y = static_cast<int>(ParseInteger(size_y, where + "sizeY", 1, kMaxSensorSide));
+        const int64_t width = ParseInteger(size_x, where + "sizeX", 1, kMaxSensorSide);
+        const int64_t height = ParseInteger(size_y, where + "sizeY", 1, kMaxSensorSide);
+        if (width * height > kMaxSensorPixels) {
+          Fail(InputError::Kind::kOutOfRange,
+               "stream description: " + where + "declares a " + std::to_string(width) + "x" +
+                   std::to_string(height) + " sensor: more than the " +
+                   std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
+        }
+        stream->size_x = static_cast<int>(width);
+        stream->size_y = static_cast<int>(height);
       }
       const char* ts_offset = Attr(info, "tsOffset");
       if (ts_offset != nullptr) {

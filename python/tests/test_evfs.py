@@ -177,6 +177,22 @@ def test_read_malformed_file_raises_the_cli_message(name):
     assert str(raised.value) == expected
 
 
+@pytest.mark.parametrize("argument", ["first", "last", "truth"])
+def test_reconstruct_index_beyond_32_bits_is_a_value_error(argument):
+    # pybind11's own conversion would raise TypeError; a bad value is a ValueError naming it.
+    frames = np.zeros((2, 4, 4))
+    events = {"t": np.zeros(0), "x": np.zeros(0, np.uint16), "y": np.zeros(0, np.uint16),
+              "p": np.zeros(0, np.int8)}
+    with pytest.raises(ValueError, match=f"{argument}={2**62} is out of range"):
+        evfs.reconstruct(frames, np.array([0.0, 1.0]), events, **{argument: 2**62})
+
+
+def test_video_index_beyond_32_bits_is_a_value_error(tmp_path):
+    with pytest.raises(ValueError, match=f"first={2**62} is out of range"):
+        evfs.video(str(tmp_path / "no_data"), str(tmp_path / "out"), first=2**62)
+    assert not (tmp_path / "out").exists()
+
+
 def test_read_missing_path_raises_the_cli_message(tmp_path):
     path = str(tmp_path / "no_such_recording")
     expected = cli_error("info", f"--data={path}")

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "io/image_io.h"
 #include "tests/examples/cli_test_util.h"
 #include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
@@ -78,24 +79,48 @@ TEST(EvfsFailure, HelpAskedForIsASuccess) {
   EXPECT_EQ(version.exit_code, 0);
 }
 
-// α = 1e308 with b = 1e-300 in g(x) = log(x + b): at any pixel with events darker than about
-// 0.5, α · g'(x) overflows, so the event residuals' Jacobian is not finite at the start and
-// Ceres ends with FAILURE. The input was accepted, so it is not the user's error (status 2) but the
-// solver's: status 4, one line (Ceres' own dump is shown with --minloglevel=0 only), and no
-// output.
+// Black frames with b = 1e-307 in g(x) = log(x + b): g'(0) = 1e307, and α = 100 times that
+// overflows, so the event residuals' Jacobian is not finite at the start and Ceres ends with
+// FAILURE. The input was accepted, so it is not the user's error (status 2) but the solver's:
+// status 4, one line (Ceres' own dump is shown with --minloglevel=0 only), and no output.
 TEST(EvfsFailure, CeresFailureIsASolverFailureNotAUserError) {
   const fs::path scratch = test::ScratchDir("failure_solver");
   const fs::path out = scratch / "out";
   const std::string data = WriteSyntheticFolder(scratch.string());
+  for (const auto& entry : fs::directory_iterator(fs::path(data) / "images")) {
+    const Image frame = ReadGreyImage(entry.path().string());
+    WriteGreyPng8(entry.path().string(), Image::Zero(frame.rows(), frame.cols()));
+  }
   const CommandResult result = RunEvfs("reconstruct --data=" + data +
-                                       " --mode=interpolate --first=0 --last=1 --alpha=1e308 "
-                                       "--log_offset=1e-300 --out=" +
+                                       " --mode=interpolate --first=0 --last=1 --alpha=100 "
+                                       "--log_offset=1e-307 --out=" +
                                        out.string());
   EXPECT_EQ(result.exit_code, kSolverFailureStatus) << result.output;
   EXPECT_EQ(Lines(result.errors).size(), 1u) << result.errors;
   EXPECT_EQ(result.errors.rfind("evfs reconstruct: the solver failed: ", 0), 0u) << result.errors;
   EXPECT_FALSE(fs::exists(out));
   ExpectNoStagingLeft(out);
+}
+
+// Flags whose values reached Ceres, or the solve, before anything named them: each is one line
+// naming the flag, before any work.
+TEST(EvfsFailure, BadSolverAndFrameFlagsNameTheFlag) {
+  const fs::path scratch = test::ScratchDir("failure_flags");
+  const fs::path out = scratch / "out";
+  const std::string data = WriteSyntheticFolder(scratch.string());
+  const std::string reconstruct =
+      "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=1 --out=" + out.string();
+  ExpectUserError(RunEvfs(reconstruct + " --alpha=1e308"), "--alpha must be at most 1e6", out);
+  ExpectUserError(RunEvfs(reconstruct + " --threads=0"), "--threads must be 1 or more", out);
+  ExpectUserError(
+      RunEvfs("reconstruct --data=" + data + " --mode=predict --first=-5 --out=" + out.string()),
+      "--first=-5: a frame number must be 0 or more", out);
+  const std::string video = "video --data=" + data + " --out=" + out.string();
+  ExpectUserError(RunEvfs(video + " --first=-5"), "--first=-5: a frame number must be 0 or more",
+                  out);
+  const CommandResult slow = RunEvfs(video + " --fps=1e-3");
+  ExpectUserError(slow, "--fps must be 0 (derived) or at least 1 frame per second", out);
+  EXPECT_EQ(slow.output.find("windows"), std::string::npos) << "solved first: " << slow.output;
 }
 
 // events.txt or images.txt that exists but is no regular file used to read as "this folder
@@ -130,6 +155,36 @@ TEST(EvfsFailure, DataFileThatIsNoRegularFileIsNamedAsSuch) {
   fs::create_directory(images_txt);
   ExpectUserError(RunEvfs("info --data=" + data.string()),
                   images_txt.string() + ": a folder, not a file of frames ('t path' lines)", out);
+}
+
+// A frame path in images.txt that leaves the recording's folder is refused on its line, for
+// every command that reads frames, unless --allow_outside_paths is given.
+TEST(EvfsFailure, FramePathsOutsideTheRecordingNeedAFlag) {
+  const fs::path scratch = test::ScratchDir("failure_outside_paths");
+  const fs::path out = scratch / "out";
+  const fs::path data = WriteSyntheticFolder(scratch.string());
+  const fs::path images_txt = data / "images.txt";
+  std::string list = test::ReadFile(images_txt);
+  const std::string first = "images/frame_0.png";
+  fs::copy_file(data / first, scratch / "outside.png");
+  for (const std::string& outside :
+       {std::string("../outside.png"), (scratch / "outside.png").string()}) {
+    SCOPED_TRACE(outside);
+    std::string changed = list;
+    changed.replace(changed.find(first), first.size(), outside);
+    test::WriteFile(images_txt.string(), changed);
+    for (const std::string& command :
+         {"info --data=" + data.string(),
+          "reconstruct --data=" + data.string() + " --mode=predict --first=0 --out=" + out.string(),
+          "convert --data=" + data.string() + " --out=" + out.string()}) {
+      SCOPED_TRACE(command);
+      ExpectUserError(RunEvfs(command), images_txt.string() + ":1", out);
+      const CommandResult allowed = RunEvfs(command + " --allow_outside_paths");
+      EXPECT_EQ(allowed.exit_code, 0) << allowed.output;
+      fs::remove_all(out);
+    }
+  }
+  test::WriteFile(images_txt.string(), list);
 }
 
 // A folder without images.txt is events alone: `info` describes it (status 0) and says why it

@@ -160,7 +160,7 @@ TEST(EvfsOutput, NewFoldersWithTrailingSlashesOrMissingParentsAreMade) {
   ASSERT_EQ(reconstruct.exit_code, 0) << reconstruct.output;
   const fs::path fresh = sandbox.root / "cwd/fresh";
   EXPECT_TRUE(fs::exists(fresh / "frames/000000.png"));
-  EXPECT_EQ(ReadFile((fresh / kOutputMarkerFile).string()), "evfs reconstruct\n");
+  EXPECT_EQ(ReadFile((fresh / kOutputMarkerFile).string()).rfind("evfs reconstruct\n", 0), 0u);
   for (const char* out : {"a/b/converted.h5", "c/d/converted", "e/f/simulated"}) {
     const std::string command = std::string(out).find("simulated") != std::string::npos
                                     ? "simulate --frames="
@@ -180,12 +180,13 @@ TEST(EvfsOutput, AnEarlierOutputIsReplacedWholeAndOnlyWithOverwrite) {
   const fs::path sim = sandbox.root / "sim";
   const std::string simulate = "simulate --frames=" + sandbox.data + " --out=" + sim.string();
   ASSERT_EQ(sandbox.Run(simulate).exit_code, 0);
-  // A file of an older run (exposures.txt once survived and changed how the data was read).
+  // A file the user added to the output: --overwrite refuses rather than delete it.
   test::WriteFile((sim / "exposures.txt").string(), "images/frame_0.png 0 0.001\n");
   ExpectRefused(sandbox.Run(simulate), "pass --overwrite to replace it");
+  ExpectRefused(sandbox.Run(simulate + " --overwrite"), "exposures.txt");
   EXPECT_TRUE(fs::exists(sim / "exposures.txt"));
+  fs::remove(sim / "exposures.txt");
   ASSERT_EQ(sandbox.Run(simulate + " --overwrite").exit_code, 0);
-  EXPECT_FALSE(fs::exists(sim / "exposures.txt")) << "an old file was mixed into the new output";
   EXPECT_TRUE(fs::exists(sim / "events.txt"));
 
   // Another command's output is not replaced, even with --overwrite.
@@ -201,6 +202,52 @@ TEST(EvfsOutput, AnEarlierOutputIsReplacedWholeAndOnlyWithOverwrite) {
   ExpectNoStagingLeft(sim);
   ExpectNoStagingLeft(h5);
   sandbox.ExpectUntouched();
+}
+
+// Files the user added inside an earlier output stop --overwrite of every command; the refusal
+// names them, and once they are moved away the output is replaced.
+TEST(EvfsOutput, OverwriteNeverDeletesWhatTheUserAddedToAnOutput) {
+  const Sandbox sandbox("added");
+  const fs::path out = sandbox.root / "out";
+  const std::vector<std::string> commands = {
+      sandbox.Reconstruct(out), "simulate --frames=" + sandbox.data + " --out=" + out.string(),
+      "video --data=" + sandbox.data + " --fps=400 --out=" + out.string(),
+      "demo --out=" + out.string()};
+  for (const std::string& command : commands) {
+    SCOPED_TRACE(command);
+    fs::remove_all(out);
+    const CommandResult first = sandbox.Run(command);
+    ASSERT_EQ(first.exit_code, 0) << first.output;
+    test::WriteFile((out / "notes.txt").string(), "mine");
+    fs::create_directories(out / "my");
+    test::WriteFile((out / "my/y").string(), "mine too");
+    const CommandResult refused = sandbox.Run(command + " --overwrite");
+    ExpectRefused(refused, "evfs did not write: my/, notes.txt");
+    EXPECT_EQ(ReadFile((out / "notes.txt").string()), "mine");
+    EXPECT_EQ(ReadFile((out / "my/y").string()), "mine too");
+    ExpectNoStagingLeft(out);
+    fs::remove(out / "notes.txt");
+    fs::remove_all(out / "my");
+    const CommandResult replaced = sandbox.Run(command + " --overwrite");
+    EXPECT_EQ(replaced.exit_code, 0) << replaced.output;
+    EXPECT_EQ(replaced.errors, "") << "nothing to warn about";
+    ExpectNoStagingLeft(out);
+  }
+  sandbox.ExpectUntouched();
+}
+
+// A marker that is a link to a file naming the command is not evfs's marker.
+TEST(EvfsOutput, ASymlinkedMarkerIsNamedAsOne) {
+  const Sandbox sandbox("marker_link");
+  const fs::path out = sandbox.root / "out";
+  fs::create_directories(out);
+  test::WriteFile((sandbox.root / "thesis/marker").string(), "evfs simulate\n");
+  fs::create_symlink(sandbox.root / "thesis/marker", out / kOutputMarkerFile);
+  ExpectRefused(
+      sandbox.Run("simulate --frames=" + sandbox.data + " --out=" + out.string() + " --overwrite"),
+      "is a symbolic link");
+  EXPECT_TRUE(fs::is_symlink(out / kOutputMarkerFile));
+  ExpectNoStagingLeft(out);
 }
 
 TEST(EvfsOutput, ABadOutFailsBeforeAnyInputIsRead) {
@@ -292,6 +339,40 @@ TEST(EvfsOutput, SighupWhileWritingFramesKeepsTheEarlierOutput) {
 
 TEST(EvfsOutput, SigtermWhileWritingFramesFromHdf5KeepsTheEarlierOutput) {
   ExpectSignalLeavesTheEarlierOutput(SIGTERM, true);
+}
+
+// SIGKILL of the main process leaves its staging folder (nothing can clean up); the next run
+// on that output removes it, since its marker shows it to be evfs's, and says so.
+TEST(EvfsOutput, AStagingFolderLeftBySigkillIsRemovedByTheNextRun) {
+  const Sandbox sandbox("sigkill");
+  const fs::path out = sandbox.root / "out";
+  ASSERT_EQ(sandbox.Run(sandbox.Reconstruct(out)).exit_code, 0);
+  const pid_t pid =
+      StartEvfs({"reconstruct", "--data=" + sandbox.data, "--mode=interpolate", "--first=0",
+                 "--last=1", "--fps=1000000", "--overwrite", "--out=" + out.string()},
+                sandbox.root);
+  ASSERT_GT(pid, 0);
+  const fs::path staging = WaitForStagedFrame(out, "000100.png", std::chrono::seconds(60));
+  ASSERT_FALSE(staging.empty()) << "evfs never wrote frames";
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  // The worker, whose id the staging name carries, dies with its parent.
+  const std::string name = staging.filename().string();
+  const size_t digits = name.rfind(".evfs-tmp-") + std::string(".evfs-tmp-").size();
+  const pid_t worker = static_cast<pid_t>(std::stol(name.substr(digits)));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (kill(worker, 0) == 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(fs::exists(staging)) << "nothing left: the test proves nothing";
+
+  const CommandResult next = sandbox.Run(sandbox.Reconstruct(out) + " --overwrite");
+  EXPECT_EQ(next.exit_code, 0) << next.output;
+  EXPECT_NE(next.errors.find("removed " + staging.string()), std::string::npos) << next.errors;
+  EXPECT_FALSE(fs::exists(staging));
+  ExpectNoStagingLeft(out);
+  sandbox.ExpectUntouched();
 }
 
 }  // namespace

@@ -246,6 +246,34 @@ TEST(EvfsVideo, AWorkFolderPathEvfsDidNotMarkIsNeverTouched) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A file the user put into an evfs work folder is neither discarded (a run without --resume
+// replaces the folder) nor mixed into a resumed run.
+TEST(EvfsVideo, WhatTheUserPutInAWorkFolderIsKept) {
+  const fs::path root = test::ScratchDir("video_work_added");
+  const std::string data = WriteSyntheticFolder(root.string(), 3, 5, 24, 16);
+  const fs::path work = root / ".out.evfs-video-work";
+  fs::create_directories(work / "frames");
+  test::WriteFile((work / ".evfs-video-work").string(), "evfs video work folder\nold settings");
+  test::WriteFile((work / "frames/000000.png").string(), "an old frame");
+  test::WriteFile((work / "frames/notes.txt").string(), "precious");
+  const fs::path out = root / "out";
+  for (const char* resume : {"", " --resume"}) {
+    SCOPED_TRACE(resume);
+    const CommandResult result =
+        RunEvfs("video --data=" + data + " --out=" + out.string() + resume);
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_EQ(std::count(result.errors.begin(), result.errors.end(), '\n'), 1) << result.errors;
+    EXPECT_NE(result.errors.find("evfs did not write: frames/notes.txt"), std::string::npos)
+        << result.errors;
+    EXPECT_EQ(ReadFile(work / "frames/notes.txt"), "precious");
+    EXPECT_FALSE(fs::exists(out));
+  }
+  fs::remove(work / "frames/notes.txt");
+  const CommandResult result = RunEvfs("video --data=" + data + " --out=" + out.string());
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_FALSE(fs::exists(work));
+}
+
 TEST(EvfsVideo, BadFlagsAreOneLineUserErrors) {
   const fs::path root = test::ScratchDir("video_bad_flags");
   const std::string data = WriteSyntheticFolder(root.string(), 3, 5, 24, 16);

@@ -985,6 +985,8 @@ TEST(Aedat4MalformedTest, HeaderProblems) {
   ExpectError("", "not an AEDAT 4.0 file");
   ExpectError("#!AER-DAT2.0\r\n#Start\r\n", "only AEDAT 4.0 is supported");
   ExpectError(kVersionLine, "truncated after the version line");
+  // Cut inside the version line: truncated, not another AEDAT version.
+  ExpectError(std::string(kVersionLine, 13), "truncated inside the version line (13 of its 14");
   ExpectError(std::string(kVersionLine) + Le32(1 << 30) + "xxxx", "IOHeader declares");
   ExpectError(std::string(kVersionLine) + Le32(12) + std::string(12, '\0'), "not a valid IOHE");
   ExpectError(HeaderBytes(9, -1, HandXml()), "unknown compression 9");
@@ -994,6 +996,8 @@ TEST(Aedat4MalformedTest, HeaderProblems) {
   ExpectError(HeaderBytes(0, -1, StreamXml({{0, "IMUS", 0, 0}})), "neither an EVTS");
   ExpectError(HeaderBytes(0, -1, StreamXml({{0, "EVTS", 0, 0}})), "gives no sensor size");
   ExpectError(HeaderBytes(0, -1, StreamXml({{0, "EVTS", 40000, 2}})), "sizeX");
+  ExpectError(HeaderBytes(0, -1, StreamXml({{0, "EVTS", 30000, 30000}})),
+              "declares a 30000x30000 sensor: more than the 67108864 pixels");
   ExpectError(HeaderBytes(0, -1, StreamXml({{0, "EVTS", 4, 3}, {0, "FRME", 4, 3}})),
               "described twice");
   ExpectError(HeaderBytes(0, -1, StreamXml({{0, "EVTS", 4, 3}, {1, "FRME", 5, 3}})),

@@ -74,6 +74,46 @@ TEST(ReadFrameListTest, MalformedLinesNameFileAndLine) {
                          InputError::Kind::kMissingFile, "/no/such/images.txt", 0);
 }
 
+// A path that leaves the folder of images.txt is refused on its line, unless the user allowed it
+// (--allow_outside_paths); ".." that stays inside is a path like any other.
+TEST(ReadFrameListTest, PathsLeavingTheFolderAreRefusedUnlessAllowed) {
+  const std::string first = "1.5 images/a.png";
+  const auto read = [](const std::string& path) { ReadFrameList(path); };
+  ExpectBadLineErrors("images.txt", first, InputError::Kind::kMalformed,
+                      {{"parent", "2.5 ../../x.png"},
+                       {"climbs_out", "2.5 images/../../x.png"},
+                       {"absolute", "2.5 /etc/x.png"}},
+                      read);
+  const std::string inside =
+      TextFile("frames_inside", "images.txt", first + "\n2.5 images/../images/b.png\n");
+  EXPECT_EQ(ReadFrameList(inside).size(), 2u);
+  const std::string outside =
+      TextFile("frames_outside", "images.txt", first + "\n2.5 ../../x.png\n3.5 /abs/y.png\n");
+  try {
+    ReadFrameList(outside);
+    ADD_FAILURE() << "a path outside the folder was read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("--allow_outside_paths"), std::string::npos)
+        << error.what();
+  }
+  SetFramePathsMayLeaveFolder(true);
+  const std::vector<FrameInfo> frames = ReadFrameList(outside);
+  SetFramePathsMayLeaveFolder(false);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[2].path, "/abs/y.png");
+}
+
+// Some Windows editors start a UTF-8 file with a byte-order mark; it is no part of the first path.
+TEST(ReadFrameListTest, AByteOrderMarkIsSkipped) {
+  const std::string path = TextFile("frames_bom", "images.txt",
+                                    "\xEF\xBB\xBF"
+                                    "1.5 images/a.png\n2.5 images/b.png\n");
+  const std::vector<FrameInfo> frames = ReadFrameList(path);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].t_ns, 1500000000);
+  EXPECT_EQ(frames[0].path, "images/a.png");
+}
+
 TEST(ReadFrameListTest, TruncatedLastLineIsMalformed) {
   // A file cut short while it was written: the last line lacks its path and its newline.
   const std::string path =

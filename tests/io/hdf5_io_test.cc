@@ -488,6 +488,10 @@ TEST(Hdf5IoTest, DeclaredSensorSizeIsCheckedBeforeAllocating) {
   DeclareSensorResolution(framed, 65535, 65535);
   test::ExpectInputError([&] { Hdf5DataSource source(framed); }, InputError::Kind::kOutOfRange,
                          "65535x65535 sensor", 0);
+  // Sides beyond what any reader takes are named as such, not as a non-positive size.
+  DeclareSensorResolution(framed, 100000, 100000);
+  test::ExpectInputError([&] { Hdf5DataSource source(framed); }, InputError::Kind::kOutOfRange,
+                         "declares a 100000x100000 sensor: beyond the 65536 pixels a side", 0);
   // Within the bound, the frames must still have the declared size.
   DeclareSensorResolution(framed, 4096, 8192);
   test::ExpectInputError([&] { Hdf5DataSource source(framed); }, InputError::Kind::kSizeMismatch,

@@ -1,7 +1,10 @@
 #include "io/image_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -71,6 +74,100 @@ TEST(ImageIoTest, MissingOrUndecodableImageIsAnInputError) {
   test::WriteFile(dir + "/garbage.png", "definitely not a png");
   test::ExpectInputError([&] { ReadGreyImage(dir + "/garbage.png"); },
                          InputError::Kind::kMissingFile, dir + "/garbage.png", 0);
+}
+
+// A PNG signature and IHDR chunk declaring `width` x `height`, then bytes that decode to
+// nothing: a reader that trusts the header would allocate for the declared size first.
+std::string PngHeader(uint32_t width, uint32_t height) {
+  std::string bytes("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR", 16);
+  for (const uint32_t side : {width, height}) {
+    for (int shift = 24; shift >= 0; shift -= 8) bytes.push_back(static_cast<char>(side >> shift));
+  }
+  return bytes + std::string("\x08\0\0\0", 5) + std::string(64, 'x');
+}
+
+// SOI, an APP0 segment, then a baseline SOF0 declaring `width` x `height`.
+std::string JpegHeader(uint16_t width, uint16_t height) {
+  std::string bytes(
+      "\xff\xd8\xff\xe0\0\x04"
+      "ab"
+      "\xff\xc0\0\x0b\x08",
+      13);
+  for (const uint16_t side : {height, width}) {
+    bytes.push_back(static_cast<char>(side >> 8));
+    bytes.push_back(static_cast<char>(side & 0xff));
+  }
+  return bytes + std::string(64, 'x');
+}
+
+TEST(ImageIoTest, TheDeclaredSizeIsReadFromTheHeader) {
+  const std::string dir = test::ScratchDir("image_header");
+  test::WriteFile(dir + "/big.png", PngHeader(20000, 30000));
+  test::WriteFile(dir + "/big.jpg", JpegHeader(40000, 20000));
+  ASSERT_TRUE(cv::imwrite(dir + "/real.png", cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(7))));
+  ASSERT_TRUE(cv::imwrite(dir + "/real.jpg", cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(7))));
+  int64_t width = 0, height = 0;
+  ASSERT_TRUE(ReadImageHeaderSize(dir + "/big.png", &width, &height));
+  EXPECT_EQ(width, 20000);
+  EXPECT_EQ(height, 30000);
+  ASSERT_TRUE(ReadImageHeaderSize(dir + "/big.jpg", &width, &height));
+  EXPECT_EQ(width, 40000);
+  EXPECT_EQ(height, 20000);
+  for (const char* name : {"real.png", "real.jpg"}) {
+    ASSERT_TRUE(ReadImageHeaderSize(dir + "/" + name, &width, &height)) << name;
+    EXPECT_EQ(width, kWidth) << name;
+    EXPECT_EQ(height, kHeight) << name;
+  }
+  test::WriteFile(dir + "/short.png", PngHeader(1, 1).substr(0, 20));
+  EXPECT_FALSE(ReadImageHeaderSize(dir + "/short.png", &width, &height));
+}
+
+// Sizes beyond the cap, or other than the one expected, are refused from the header alone:
+// the message names the declared size, not a failed decode.
+TEST(ImageIoTest, AHugeOrMismatchedDeclaredSizeIsRefusedBeforeDecoding) {
+  const std::string dir = test::ScratchDir("image_huge");
+  test::WriteFile(dir + "/huge.png", PngHeader(30000, 30000));
+  test::WriteFile(dir + "/huge.jpg", JpegHeader(30000, 30000));
+  for (const char* name : {"huge.png", "huge.jpg"}) {
+    const std::string path = dir + "/" + name;
+    test::ExpectInputError([&] { ReadGreyImage(path); }, InputError::Kind::kOutOfRange, path, 0);
+    try {
+      ReadGreyImage(path);
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("30000x30000"), std::string::npos) << error.what();
+    }
+  }
+  test::WriteFile(dir + "/other.png", PngHeader(kWidth + 1, kHeight));
+  test::ExpectInputError([&] { ReadGreyImage(dir + "/other.png", kWidth, kHeight); },
+                         InputError::Kind::kSizeMismatch, dir + "/other.png", 0);
+  ASSERT_TRUE(cv::imwrite(dir + "/fits.png", cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(7))));
+  EXPECT_EQ(ReadGreyImage(dir + "/fits.png", kWidth, kHeight).cols(), kWidth);
+}
+
+// A folder, a FIFO or an unreadable file where a frame should be is named as what it is, not as
+// a missing file or one that does not decode.
+TEST(ImageIoTest, AFolderAFifoOrAnUnreadableFileIsNamed) {
+  const std::string dir = test::ScratchDir("image_not_a_file");
+  std::filesystem::create_directories(dir + "/folder.png");
+  ASSERT_EQ(mkfifo((dir + "/fifo.png").c_str(), 0600), 0);
+  const auto message = [](const std::string& path) {
+    try {
+      ReadGreyImage(path);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(dir + "/folder.png").find("a folder, not an image file"), std::string::npos)
+      << message(dir + "/folder.png");
+  EXPECT_NE(message(dir + "/fifo.png").find("a FIFO, socket or device"), std::string::npos)
+      << message(dir + "/fifo.png");
+  if (geteuid() == 0) GTEST_SKIP() << "running as root: file permissions do not stop reading";
+  ASSERT_TRUE(cv::imwrite(dir + "/locked.png", cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(7))));
+  std::filesystem::permissions(dir + "/locked.png", std::filesystem::perms::none);
+  EXPECT_NE(message(dir + "/locked.png").find("cannot read the image file: Permission denied"),
+            std::string::npos)
+      << message(dir + "/locked.png");
 }
 
 TEST(ImageIoTest, UnwritableImageIsAnInputError) {

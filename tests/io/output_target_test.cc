@@ -81,8 +81,129 @@ TEST(OutputTargetTest, NewFolderAppearsWholeWithItsMarker) {
     target.Commit();
   }
   EXPECT_EQ(test::ReadFile((out / "result.txt").string()), "new");
-  EXPECT_EQ(test::ReadFile((out / kOutputMarkerFile).string()), "evfs reconstruct\n");
+  EXPECT_EQ(test::ReadFile((out / kOutputMarkerFile).string()),
+            "evfs reconstruct\nfile result.txt\n");
   EXPECT_TRUE(sandbox.Others(out.parent_path(), "out").empty());
+}
+
+TEST(OutputTargetTest, OverwriteRefusesWhatTheMarkerDoesNotList) {
+  const Sandbox sandbox("foreign");
+  const fs::path out = sandbox.root / "out";
+  {
+    OutputTarget target(sandbox.Options(out));
+    WriteIn(target.staging() + "/frames", "000000.png", "frame");
+    target.Commit();
+  }
+  EXPECT_EQ(test::ReadFile((out / kOutputMarkerFile).string()),
+            "evfs reconstruct\nfile frames/000000.png\nfolder frames\n");
+  OutputOptions overwrite = sandbox.Options(out);
+  overwrite.overwrite = true;
+  WriteIn((out / "frames").string(), "mine.png", "mine");
+  WriteIn((out / "my").string(), "y", "mine");
+  try {
+    OutputTarget target(overwrite);
+    ADD_FAILURE() << "replaced an output holding the user's files";
+  } catch (const InvalidArgumentError& error) {
+    EXPECT_NE(std::string(error.what()).find("did not write: frames/mine.png, my/"),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_EQ(test::ReadFile((out / "my/y").string()), "mine");
+  // A file where evfs wrote a folder is foreign too.
+  fs::remove_all(out / "my");
+  fs::remove(out / "frames/mine.png");
+  fs::rename(out / "frames", sandbox.root / "frames");
+  test::WriteFile((out / "frames").string(), "a file now");
+  EXPECT_THROW(OutputTarget target(overwrite), InvalidArgumentError);
+  fs::remove(out / "frames");
+  MakeOutput(overwrite, "new.txt");
+  EXPECT_EQ(test::ReadFile((out / "new.txt").string()), "new.txt");
+  EXPECT_TRUE(sandbox.Others(sandbox.root, "out").size() == 5u) << "a staging folder was left";
+}
+
+TEST(OutputTargetTest, AMarkerThatIsALinkOrNotAFileIsNamed) {
+  const Sandbox sandbox("marker_link");
+  const fs::path out = sandbox.root / "out";
+  fs::create_directories(out);
+  test::WriteFile((sandbox.root / "marker").string(), "evfs reconstruct\n");
+  fs::create_symlink(sandbox.root / "marker", out / kOutputMarkerFile);
+  OutputOptions overwrite = sandbox.Options(out);
+  overwrite.overwrite = true;
+  try {
+    OutputTarget target(overwrite);
+    ADD_FAILURE() << "a linked marker was taken as evfs's";
+  } catch (const InvalidArgumentError& error) {
+    EXPECT_NE(std::string(error.what()).find("is a symbolic link"), std::string::npos)
+        << error.what();
+  }
+}
+
+// A process id that no process has now: a child that has exited and been reaped.
+pid_t DeadProcessId() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  return child;
+}
+
+TEST(OutputTargetTest, LeftoversOfADeadRunAreRemovedOnlyWhenTheyAreEvfss) {
+  const Sandbox sandbox("leftovers");
+  const fs::path out = sandbox.root / "out";
+  MakeOutput(sandbox.Options(out), "old.txt");
+  const std::string dead = std::to_string(DeadProcessId());
+  const std::string alive = std::to_string(getppid());
+  // Removed: an empty staging folder, a staging folder marked unfinished, and an earlier output
+  // moved aside that holds only what its marker lists.
+  fs::create_directories(sandbox.root / (".out.evfs-tmp-" + dead + "-0"));
+  WriteIn((sandbox.root / (".out.evfs-tmp-" + dead + "-1")).string(), kOutputMarkerFile,
+          "evfs reconstruct\nunfinished\n");
+  WriteIn((sandbox.root / (".out.evfs-tmp-" + dead + "-1/frames")).string(), "0.png", "x");
+  fs::copy(out, sandbox.root / (".out.evfs-old-" + dead + "-0"), fs::copy_options::recursive);
+  // Kept: one of a running process, one without a marker, one holding a file of the user's, and
+  // names that only look alike.
+  const std::vector<std::string> kept = {
+      ".out.evfs-tmp-" + alive + "-0", ".out.evfs-tmp-" + dead + "-2",
+      ".out.evfs-old-" + dead + "-1", ".out.evfs-tmp-" + dead + "-x", ".out.evfs-video-work"};
+  for (const std::string& name : kept) fs::create_directories(sandbox.root / name);
+  WriteIn((sandbox.root / kept[0]).string(), "partial.png", "x");
+  WriteIn((sandbox.root / kept[1]).string(), "notes.txt", "mine");
+  fs::copy(out, sandbox.root / kept[2], fs::copy_options::recursive);
+  WriteIn((sandbox.root / kept[2]).string(), "notes.txt", "mine");
+
+  OutputOptions overwrite = sandbox.Options(out);
+  overwrite.overwrite = true;
+  std::vector<std::string> notes;
+  overwrite.warn = [&notes](const std::string& note) { notes.push_back(note); };
+  MakeOutput(overwrite, "new.txt");
+  EXPECT_EQ(notes.size(), 3u);
+  for (const std::string& note : notes) {
+    EXPECT_EQ(note.rfind("removed " + sandbox.root.string() + "/.out.evfs-", 0), 0u) << note;
+  }
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(sandbox.root / name)) << name;
+  EXPECT_EQ(sandbox.Others(sandbox.root, "out").size(), 4u + kept.size());
+  EXPECT_EQ(test::ReadFile((out / "new.txt").string()), "new.txt");
+}
+
+// Read-only folders inside an earlier output (a user protecting frames/) do not leave it
+// behind once it is replaced.
+TEST(OutputTargetTest, AReplacedOutputWithReadOnlyFoldersIsRemoved) {
+  if (geteuid() == 0) GTEST_SKIP() << "running as root: file permissions do not stop removal";
+  const Sandbox sandbox("read_only");
+  const fs::path out = sandbox.root / "out";
+  {
+    OutputTarget target(sandbox.Options(out));
+    WriteIn(target.staging() + "/frames", "000000.png", "frame");
+    target.Commit();
+  }
+  fs::permissions(out / "frames", fs::perms::owner_read | fs::perms::owner_exec);
+  OutputOptions overwrite = sandbox.Options(out);
+  overwrite.overwrite = true;
+  std::vector<std::string> notes;
+  overwrite.warn = [&notes](const std::string& note) { notes.push_back(note); };
+  MakeOutput(overwrite, "new.txt");
+  EXPECT_TRUE(notes.empty());
+  EXPECT_EQ(sandbox.Others(sandbox.root, "out").size(), 4u) << "the earlier output was left";
 }
 
 TEST(OutputTargetTest, FailureRemovesStagingAndTheParentsItMade) {
