@@ -28,6 +28,15 @@ constexpr uint64_t kLeakSeedOffset = 2 * kNoiseSeedOffset;
 constexpr uint64_t kHotPixelSeedOffset = 3 * kNoiseSeedOffset;        // which pixels are hot
 constexpr uint64_t kHotPixelEventSeedOffset = 4 * kNoiseSeedOffset;   // when they fire
 
+/// v2e's dark offset: 20 DN of 8-bit intensity added before the cutoff is scaled by intensity,
+/// so a black pixel keeps 20/275 of the full cutoff.
+constexpr double kBandwidthDarkOffset = 20.0 / 255.0;
+
+/// Largest 2π · cutoff · Δt of one step of the low-pass (BandwidthMaxStepNs).
+constexpr double kMaxLowPassStep = 0.25;
+
+constexpr double kTwoPi = 6.283185307179586476925;
+
 /// Largest sensor side: event coordinates are uint16.
 constexpr int kMaxSensorSide = 65536;
 
@@ -89,6 +98,12 @@ void CheckEventBudget(const SimulatorOptions& options, double expected, const st
 
 }  // namespace
 
+int64_t SimulatorOptions::BandwidthMaxStepNs() const {
+  if (cutoff_hz <= 0.0) return kNanosecondsPerSecond;
+  return std::max<int64_t>(
+      1, static_cast<int64_t>(kMaxLowPassStep / (kTwoPi * cutoff_hz) * kNanosecondsPerSecond));
+}
+
 bool SimulatorOptions::IsValid(std::string* error) const {
   OptionChecker check;
   check.Positive("contrast_threshold_pos", contrast_threshold_pos)
@@ -98,6 +113,7 @@ bool SimulatorOptions::IsValid(std::string* error) const {
       .NonNegative("noise_rate_hz", noise_rate_hz)
       .Positive("log_eps", log_eps)
       .NonNegative("leak_rate_hz", leak_rate_hz)
+      .Require(cutoff_hz >= 0.0 && cutoff_hz <= 1e6, "cutoff_hz", "in [0, 1e6] Hz (0: no low-pass)")
       .NonNegative("leak_jitter_fraction", leak_jitter_fraction)
       .Require(hot_pixel_fraction >= 0.0 && hot_pixel_fraction <= 1.0, "hot_pixel_fraction",
                "in [0, 1]")
@@ -187,7 +203,14 @@ void EventSimulator::AddSignalEvents(const Image& next_frame, int64_t t_ns,
     const double leak_after = leaks ? leak_before + leak_per_s_[p] * interval_s : 0.0;
     if (leaks) leak_[p] = leak_after;
     const double log_before = log_intensity_[p] + leak_before;
-    const double log_after_frame = std::log(next_frame.data()[p] + options_.log_eps);
+    double log_after_frame = std::log(next_frame.data()[p] + options_.log_eps);
+    if (options_.cutoff_hz > 0.0) {
+      // v2e's photoreceptor: the cutoff scales with the new intensity (plus the dark offset).
+      const double intensity = (next_frame.data()[p] + kBandwidthDarkOffset) /
+                               (1.0 + kBandwidthDarkOffset);
+      const double step = std::min(1.0, kTwoPi * options_.cutoff_hz * intensity * interval_s);
+      log_after_frame = log_intensity_[p] + step * (log_after_frame - log_intensity_[p]);
+    }
     log_intensity_[p] = log_after_frame;
     const double log_after = log_after_frame + leak_after;
     if (log_after == log_before) continue;
@@ -299,7 +322,7 @@ EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options,
                        "x" + std::to_string(frames.height()) + " pixels and " +
                        std::to_string(duration_ns / kNanosecondsPerSecond) + " s gives about");
   EventStream events(frames.width(), frames.height());
-  if (!flicker.enabled()) {
+  if (!flicker.enabled() && options.cutoff_hz <= 0.0) {
     simulator.Reset(frames.frame(0), frames.timestamp_ns(0));
     for (int t = 1; t < frames.num_frames(); ++t) {
       events.Append(simulator.Advance(frames.frame(t), frames.timestamp_ns(t)));
@@ -318,7 +341,9 @@ EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options,
     AddLightSources(flicker, t_ns, &scene);
     return scene;
   };
-  const int64_t max_step_ns = flicker.MaxStepNs();
+  const int64_t max_step_ns =
+      std::min(flicker.enabled() ? flicker.MaxStepNs() : kNanosecondsPerSecond,
+               options.BandwidthMaxStepNs());
   Image frame = frames.frame(0);
   AddLightSources(flicker, frames.timestamp_ns(0), &frame);
   simulator.Reset(frame, frames.timestamp_ns(0));

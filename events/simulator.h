@@ -13,8 +13,12 @@
 // pixel emits without any change of light because junction leakage slowly discharges its
 // reference (v2e §3, default 0.1 Hz with a 10 % per-pixel spread), and hot pixels, the few
 // pixels whose noise rate is orders of magnitude above the rest (v2e draws per-pixel shot noise
-// rates with a spread for the same reason). Flickering light sources (events/flicker.h) are
-// sampled between frames by SimulateEvents.
+// rates with a spread for the same reason), and the photoreceptor's bandwidth, which falls with
+// the light: v2e's intensity-dependent first-order low-pass of log intensity (v2e §3.2),
+//   L_lp ← L_lp + a · (L - L_lp),   a = min(1, 2π · cutoff_hz · (I + 20/255) / (1 + 20/255) · Δt),
+// so that a white pixel follows the light with the time constant 1 / (2π cutoff_hz) and a black
+// one 275/20 = 13.75 times slower (v2e adds 20 DN to the 8-bit intensity for the dark current).
+// Flickering light sources (events/flicker.h) are sampled between frames by SimulateEvents.
 #ifndef EVFS_EVENTS_SIMULATOR_H_
 #define EVFS_EVENTS_SIMULATOR_H_
 
@@ -47,9 +51,17 @@ struct SimulatorOptions {
   double leak_rate_hz = 0.0;
   /// Per-pixel spread of the leak rate as a fraction of it, >= 0 (v2e's leak_jitter_fraction).
   double leak_jitter_fraction = 0.1;
+  /// Photoreceptor cutoff frequency at full intensity in Hz, >= 0 (v2e's cutoff_hz); 0: no
+  /// low-pass, the pixel follows the light at once. With it, SimulateEvents sub-steps every
+  /// frame interval so that a · Δt stays small (see BandwidthMaxStepNs).
+  double cutoff_hz = 0.0;
   double hot_pixel_fraction = 0.0;  // fraction of pixels that are hot, in [0, 1]
   double hot_pixel_rate_hz = 100.0;  // events per second of each hot pixel (random sign), > 0
   uint64_t seed = 42;  // seeds the thresholds, the noise, the leak and the hot pixels
+
+  /// The longest sub-step of the low-pass, 2π · cutoff_hz · Δt <= 1/4, so that the filter's
+  /// discrete steps follow its continuous response; only meaningful when cutoff_hz > 0.
+  int64_t BandwidthMaxStepNs() const;
   /// Most events one Advance (and SimulateEvents in all) may produce, > 0: about 30 bytes each
   /// while simulating, so the default bounds memory near 3 GB. Background noise beyond it is
   /// refused before it is drawn (noise_rate_hz × pixels × seconds is known in advance).
@@ -121,7 +133,7 @@ class EventSimulator {
   SimulatorOptions options_;
   std::vector<double> threshold_pos_;   // per-pixel C_pos
   std::vector<double> threshold_neg_;   // per-pixel C_neg
-  std::vector<double> log_intensity_;   // L at the previous frame
+  std::vector<double> log_intensity_;   // L (low-passed with cutoff_hz) at the previous frame
   std::vector<double> reference_;       // the level the next crossing is measured from
   std::vector<int64_t> last_event_ns_;  // last emitted event per pixel (refractory)
   std::vector<double> leak_per_s_;      // per-pixel leak of the reference, log intensity / s
@@ -135,10 +147,10 @@ class EventSimulator {
 };
 
 /// Simulates the events of a whole video (frame 0 starts the sensor); the stream's sensor size
-/// is the video's. With light sources (`flicker` enabled) the sensor sees the scene at
-/// sub-steps of at most flicker.MaxStepNs(), evenly spaced in every frame interval: the frames'
-/// log intensities interpolated linearly, back to linear intensity, plus the light sources at
-/// that instant. Throws InvalidArgumentError for an empty video or invalid flicker options, when
+/// is the video's. With light sources (`flicker` enabled) or a photoreceptor cutoff the sensor
+/// sees the scene at sub-steps of at most flicker.MaxStepNs() and options.BandwidthMaxStepNs(),
+/// evenly spaced in every frame interval: the frames' log intensities interpolated linearly,
+/// back to linear intensity, plus the light sources at that instant. Throws InvalidArgumentError for an empty video or invalid flicker options, when
 /// the expected noise, hot pixel and leak events over the whole video or the events produced
 /// exceed options.max_events, or as EventSimulator does.
 EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options,

@@ -437,6 +437,46 @@ TEST(EventSimulator, MainsLampFiresWithinItsRegionAtTwiceThePeriod) {
   EXPECT_NEAR(changes, 20, 1);
 }
 
+// v2e's photoreceptor: after the same step of log intensity, a bright pixel follows within a
+// few of its time constants 1 / (2π · 100 Hz) = 1.6 ms, a dim one (cutoff scaled by its
+// intensity) several times slower, and without the low-pass both fire within the step.
+TEST(EventSimulator, BandwidthFallsWithIntensity) {
+  constexpr int64_t kFrameIntervalNs = 1000000;
+  constexpr int kNumFrames = 61;  // 60 ms: past the dim pixels' third time constant
+  Image dim_before = Image::Constant(8, 16, 0.05);
+  Image after = Image::Constant(8, 16, 0.1);
+  dim_before.rightCols(8) = 0.5;  // the right half is bright
+  after.rightCols(8) = 1.0;       // the same step of log intensity on both sides
+  Video video;
+  video.AppendFrame(dim_before, 0);
+  for (int t = 1; t < kNumFrames; ++t) video.AppendFrame(after, t * kFrameIntervalNs);
+
+  const auto mean_times_ms = [&video](const SimulatorOptions& options) {
+    const EventStream events = SimulateEvents(video, options);
+    EXPECT_EQ(events.CountPositive(), events.size());
+    // ln 2 is three thresholds of 0.2 at every pixel, low-pass or not.
+    EXPECT_EQ(events.size(), 3u * 8 * 16);
+    double dim_ms = 0.0, bright_ms = 0.0;
+    for (size_t i = 0; i < events.size(); ++i) {
+      (events.x(i) < 8 ? dim_ms : bright_ms) += events.t_ns(i) * 1e-6;
+    }
+    return std::make_pair(dim_ms / (events.size() / 2.0), bright_ms / (events.size() / 2.0));
+  };
+  SimulatorOptions options = IdealOptions();
+  const auto [dim_instant_ms, bright_instant_ms] = mean_times_ms(options);
+  EXPECT_LE(dim_instant_ms, 1.0);
+  EXPECT_LE(bright_instant_ms, 1.0);
+  options.cutoff_hz = 100.0;
+  const auto [dim_ms, bright_ms] = mean_times_ms(options);
+  // Crossings at 29, 58 and 88 % of the step: -τ ln(1 - f) averages 1.1 τ, during and after
+  // the 1 ms ramp, with τ = 1.6 ms bright and 9.6 ms dim. The bounds leave room for the ramp and
+  // the discrete steps, and exclude the instant response (about 0.5 ms).
+  EXPECT_GT(bright_ms, 1.2);
+  EXPECT_LT(bright_ms, 4.0);
+  EXPECT_GT(dim_ms, 3.0 * bright_ms);
+  EXPECT_LT(dim_ms, 25.0);
+}
+
 TEST(EventSimulator, RejectsBadEffectOptions) {
   SimulatorOptions options;
   std::string error;
@@ -451,6 +491,10 @@ TEST(EventSimulator, RejectsBadEffectOptions) {
   options.hot_pixel_rate_hz = 0.0;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_NE(error.find("hot_pixel_rate_hz"), std::string::npos) << error;
+  options = SimulatorOptions();
+  options.cutoff_hz = -1.0;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("cutoff_hz"), std::string::npos) << error;
 
   FlickerOptions flicker;
   EXPECT_TRUE(flicker.IsValid(&error)) << error;
