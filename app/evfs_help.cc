@@ -131,6 +131,7 @@ ProgramHelp MakeEvfsHelp() {
       {"seed", "simulator", "simulate"},
       {"leak_rate_hz", "simulator", "simulate"},
       {"leak_jitter_fraction", "simulator", "simulate"},
+      {"cutoff_hz", "simulator", "simulate"},
       {"hot_pixel_fraction", "simulator", "simulate"},
       {"hot_pixel_rate_hz", "simulator", "simulate"},
       {"flicker_led_hz", "simulator", "simulate"},

@@ -277,6 +277,9 @@ DEFINE_double(leak_rate_hz, evfs::SimulatorOptions().leak_rate_hz,
               "simulate: leak (ON) events per pixel per second (v2e's default: 0.1); 0: none.");
 DEFINE_double(leak_jitter_fraction, evfs::SimulatorOptions().leak_jitter_fraction,
               "simulate: per-pixel spread of the leak rate, a fraction of it (v2e).");
+DEFINE_double(cutoff_hz, evfs::SimulatorOptions().cutoff_hz,
+              "simulate: photoreceptor cutoff frequency at full intensity in Hz, falling with "
+              "intensity (v2e); 0: none.");
 DEFINE_double(hot_pixel_fraction, evfs::SimulatorOptions().hot_pixel_fraction,
               "simulate: fraction of pixels that are hot, in [0, 1].");
 DEFINE_double(hot_pixel_rate_hz, evfs::SimulatorOptions().hot_pixel_rate_hz,
@@ -399,6 +402,7 @@ int RunSimulate() {
   options.seed = FLAGS_seed;
   options.leak_rate_hz = FLAGS_leak_rate_hz;
   options.leak_jitter_fraction = FLAGS_leak_jitter_fraction;
+  options.cutoff_hz = FLAGS_cutoff_hz;
   options.hot_pixel_fraction = FLAGS_hot_pixel_fraction;
   options.hot_pixel_rate_hz = FLAGS_hot_pixel_rate_hz;
   std::string error;
