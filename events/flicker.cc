@@ -38,8 +38,9 @@ int64_t FlickerOptions::MaxStepNs() const {
 
 bool FlickerOptions::IsValid(std::string* error) const {
   OptionChecker check;
-  check.Require(led_hz == 0.0 || (led_hz >= 1.0 && led_hz <= kMaxLedHz), "led_hz",
-                "0 (no LED) or in [1, 100000]")
+  check
+      .Require(led_hz == 0.0 || (led_hz >= 1.0 && led_hz <= kMaxLedHz), "led_hz",
+               "0 (no LED) or in [1, 100000]")
       .Require(std::isfinite(led_x_px) && std::isfinite(led_y_px), "led_x_px and led_y_px",
                "finite")
       .Positive("led_radius_px", led_radius_px)
@@ -87,8 +88,8 @@ void AddLightSources(const FlickerOptions& options, int64_t t_ns, Image* scene) 
     // Only the disc's bounding box is visited (clamped in double: the centre may lie far
     // outside the frame).
     const auto first = [&](double centre, Eigen::Index size) {
-      return static_cast<int>(std::clamp(std::floor(centre - options.led_radius_px), 0.0,
-                                         static_cast<double>(size)));
+      return static_cast<int>(
+          std::clamp(std::floor(centre - options.led_radius_px), 0.0, static_cast<double>(size)));
     };
     const auto last = [&](double centre, Eigen::Index size) {
       return static_cast<int>(std::clamp(std::ceil(centre + options.led_radius_px), -1.0,

@@ -28,14 +28,14 @@ namespace evfs {
 
 /// The light sources of the scene; by default there are none and the scene is the frames.
 struct FlickerOptions {
-  double led_hz = 0.0;            // LED blink frequency in Hz; 0: no LED, else in [1, 100000]
-  double led_x_px = 0.0;          // LED disc centre, column (pixel centres at integers)
-  double led_y_px = 0.0;          // LED disc centre, row
-  double led_radius_px = 4.0;     // LED disc radius in pixels, > 0: pixels within it are lit
-  double led_intensity = 4.0;     // linear intensity added while on (1 is white), > 0
-  double led_duty = 0.5;          // fraction of each period the LED is on, in (0, 1)
-  double mains_hz = 0.0;          // lamp flicker frequency in Hz (100 or 120); 0: no lamp
-  double mains_depth = 0.3;       // modulation depth of the lamp, in [0, 1]
+  double led_hz = 0.0;         // LED blink frequency in Hz: 0 (no LED) or in [1, 100000]
+  double led_x_px = 0.0;       // LED disc centre, column (pixel centres at integers)
+  double led_y_px = 0.0;       // LED disc centre, row
+  double led_radius_px = 4.0;  // LED disc radius in pixels, > 0: the pixels within it are lit
+  double led_intensity = 4.0;  // linear intensity added while on (1 is white), > 0
+  double led_duty = 0.5;       // fraction of each period the LED is on, in (0, 1)
+  double mains_hz = 0.0;       // lamp flicker frequency in Hz (100 or 120); 0: no lamp
+  double mains_depth = 0.3;    // modulation depth of the lamp, in [0, 1]
   /// The region the lamp lights (x, y of the top-left pixel, width, height); a width or height
   /// of 0 means the whole frame.
   int mains_x_px = 0;

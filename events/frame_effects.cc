@@ -56,7 +56,8 @@ std::vector<int64_t> ExposureSampleTimes(int64_t begin_ns, int64_t end_ns, int64
   const double length_ns = static_cast<double>(end_ns - begin_ns);
   const int64_t num_samples = std::max<int64_t>(
       kMinExposureSamples,
-      static_cast<int64_t>(std::ceil(length_ns / static_cast<double>(std::max<int64_t>(1, max_step_ns)))));
+      static_cast<int64_t>(
+          std::ceil(length_ns / static_cast<double>(std::max<int64_t>(1, max_step_ns)))));
   std::vector<int64_t> times(num_samples);
   for (int64_t i = 0; i < num_samples; ++i) {
     times[i] = begin_ns + std::llround(length_ns * (static_cast<double>(i) + 0.5) /
@@ -98,9 +99,8 @@ FrameReadout::FrameReadout(int height, int width, const FrameEffectsOptions& opt
 
 Image FrameReadout::Read(const Image& exposed) {
   if (exposed.rows() != gain_.rows() || exposed.cols() != gain_.cols()) {
-    throw InvalidArgumentError("FrameReadout::Read: a frame of " +
-                               std::to_string(exposed.cols()) + "x" +
-                               std::to_string(exposed.rows()) + ", sensor is " +
+    throw InvalidArgumentError("FrameReadout::Read: a frame of " + std::to_string(exposed.cols()) +
+                               "x" + std::to_string(exposed.rows()) + ", sensor is " +
                                std::to_string(gain_.cols()) + "x" + std::to_string(gain_.rows()));
   }
   Image value = gain_ * exposed + offset_;
@@ -128,7 +128,8 @@ std::vector<RecordedFrame> RecordFrames(const Video& frames, const FlickerOption
   for (int t = 1; t < frames.num_frames(); ++t) {
     const int64_t interval_ns = frames.timestamp_ns(t) - frames.timestamp_ns(t - 1);
     if (interval_ns > 0) {
-      max_step_ns = std::min(max_step_ns, std::max<int64_t>(1, interval_ns / kSamplesPerFrameInterval));
+      max_step_ns =
+          std::min(max_step_ns, std::max<int64_t>(1, interval_ns / kSamplesPerFrameInterval));
     }
   }
   const int64_t half_exposure_ns = SecondsToNanoseconds(options.exposure_s / 2.0);

@@ -3,7 +3,8 @@
 // simulated from the true scene (events/simulator.h); these effects touch the frames only.
 //
 // Readout of one pixel p with exposed (time-averaged) intensity E_p, all in [0, 1] = [0, 255] DN:
-//   v_p = gain · (1 + g_p) · E_p + o_p / 255 + n / 255,   frame_p = round(255 · clip(v_p, 0, 1)) / 255
+//   v_p = gain · (1 + g_p) · E_p + o_p / 255 + n / 255
+//   frame_p = round(255 · clip(v_p, 0, 1)) / 255
 // with g_p ~ N(0, fpn_gain_sigma) and o_p ~ N(0, fpn_offset_dn) drawn once per sensor (the
 // photo-response non-uniformity and dark-signal non-uniformity of EMVA 1288, the fixed pattern
 // of a CMOS imager such as the DAVIS APS: C. Brandli et al., "A 240 × 180 130 dB 3 µs latency

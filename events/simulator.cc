@@ -25,8 +25,8 @@ constexpr uint64_t kNoiseSeedOffset = 0x9E3779B97F4A7C15ull;
 /// Offsets of the leak and hot pixel generators' seeds (further multiples of the same constant),
 /// so that turning an effect on leaves the thresholds and the noise of the others unchanged.
 constexpr uint64_t kLeakSeedOffset = 2 * kNoiseSeedOffset;
-constexpr uint64_t kHotPixelSeedOffset = 3 * kNoiseSeedOffset;        // which pixels are hot
-constexpr uint64_t kHotPixelEventSeedOffset = 4 * kNoiseSeedOffset;   // when they fire
+constexpr uint64_t kHotPixelSeedOffset = 3 * kNoiseSeedOffset;       // which pixels are hot
+constexpr uint64_t kHotPixelEventSeedOffset = 4 * kNoiseSeedOffset;  // when they fire
 
 /// v2e's dark offset: 20 DN of 8-bit intensity added before the cutoff is scaled by intensity,
 /// so a black pixel keeps 20/275 of the full cutoff.
@@ -146,16 +146,15 @@ EventSimulator::EventSimulator(int height, int width, const SimulatorOptions& op
     leak_per_s_.resize(num_pixels);
     leak_start_.resize(num_pixels);
     for (size_t p = 0; p < num_pixels; ++p) {
-      const double rate_hz = std::max(
-          0.0, leak_random.Normal(options.leak_rate_hz,
-                                  options.leak_jitter_fraction * options.leak_rate_hz));
+      const double rate_hz =
+          std::max(0.0, leak_random.Normal(options.leak_rate_hz,
+                                           options.leak_jitter_fraction * options.leak_rate_hz));
       leak_per_s_[p] = rate_hz * threshold_pos_[p];
       leak_start_[p] = leak_random.Uniform() * threshold_pos_[p];
     }
   }
   if (options.hot_pixel_fraction > 0.0) {
-    const size_t count =
-        static_cast<size_t>(std::llround(options.hot_pixel_fraction * num_pixels));
+    const size_t count = static_cast<size_t>(std::llround(options.hot_pixel_fraction * num_pixels));
     Random hot_pixel_choice(options.seed + kHotPixelSeedOffset);
     hot_pixels_ = DrawDistinctPixels(count, num_pixels, &hot_pixel_choice);
   }
@@ -206,8 +205,8 @@ void EventSimulator::AddSignalEvents(const Image& next_frame, int64_t t_ns,
     double log_after_frame = std::log(next_frame.data()[p] + options_.log_eps);
     if (options_.cutoff_hz > 0.0) {
       // v2e's photoreceptor: the cutoff scales with the new intensity (plus the dark offset).
-      const double intensity = (next_frame.data()[p] + kBandwidthDarkOffset) /
-                               (1.0 + kBandwidthDarkOffset);
+      const double intensity =
+          (next_frame.data()[p] + kBandwidthDarkOffset) / (1.0 + kBandwidthDarkOffset);
       const double step = std::min(1.0, kTwoPi * options_.cutoff_hz * intensity * interval_s);
       log_after_frame = log_intensity_[p] + step * (log_after_frame - log_intensity_[p]);
     }
@@ -318,8 +317,8 @@ EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options,
   const double duration_ns = static_cast<double>(frames.timestamp_ns(frames.num_frames() - 1)) -
                              static_cast<double>(frames.timestamp_ns(0));
   CheckEventBudget(options, ExpectedNoiseEvents(options, num_pixels, duration_ns),
-                   UnsignalledRateText(options) + " over " + std::to_string(frames.width()) +
-                       "x" + std::to_string(frames.height()) + " pixels and " +
+                   UnsignalledRateText(options) + " over " + std::to_string(frames.width()) + "x" +
+                       std::to_string(frames.height()) + " pixels and " +
                        std::to_string(duration_ns / kNanosecondsPerSecond) + " s gives about");
   EventStream events(frames.width(), frames.height());
   if (!flicker.enabled() && options.cutoff_hz <= 0.0) {

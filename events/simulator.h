@@ -9,15 +9,19 @@
 // at every pixel (the round trip ESIM is tested by).
 //
 // Sensor effects beyond ESIM's, each off by default, follow v2e (Y. Hu, S.-C. Liu, T. Delbruck,
-// "v2e: From Video Frames to Realistic DVS Events", CVPRW 2021): leak events, the ON events a
-// pixel emits without any change of light because junction leakage slowly discharges its
-// reference (v2e §3, default 0.1 Hz with a 10 % per-pixel spread), and hot pixels, the few
-// pixels whose noise rate is orders of magnitude above the rest (v2e draws per-pixel shot noise
-// rates with a spread for the same reason), and the photoreceptor's bandwidth, which falls with
-// the light: v2e's intensity-dependent first-order low-pass of log intensity (v2e §3.2),
-//   L_lp ← L_lp + a · (L - L_lp),   a = min(1, 2π · cutoff_hz · (I + 20/255) / (1 + 20/255) · Δt),
-// so that a white pixel follows the light with the time constant 1 / (2π cutoff_hz) and a black
-// one 275/20 = 13.75 times slower (v2e adds 20 DN to the 8-bit intensity for the dark current).
+// "v2e: From Video Frames to Realistic DVS Events", CVPRW 2021):
+//   - leak events: ON events a pixel emits without any change of light, because junction
+//     leakage slowly discharges its reference (v2e's leak_rate_hz, by default 0.1 Hz, with a
+//     10 % per-pixel spread);
+//   - hot pixels: the few pixels whose noise rate is orders of magnitude above the rest (v2e
+//     draws per-pixel shot noise rates with a spread for the same reason);
+//   - the photoreceptor's bandwidth, which falls with the light: v2e's intensity-dependent
+//     first-order low-pass of log intensity,
+//       L_lp ← L_lp + a · (L - L_lp),
+//       a = min(1, 2π · cutoff_hz · (I + 20/255) / (1 + 20/255) · Δt),
+//     so that a white pixel follows the light with the time constant 1 / (2π cutoff_hz) and a
+//     black one 275/20 = 13.75 times slower (v2e adds 20 DN to the 8-bit intensity, which bounds
+//     the darkest pixel's time constant).
 // Flickering light sources (events/flicker.h) are sampled between frames by SimulateEvents.
 #ifndef EVFS_EVENTS_SIMULATOR_H_
 #define EVFS_EVENTS_SIMULATOR_H_
@@ -55,9 +59,9 @@ struct SimulatorOptions {
   /// low-pass, the pixel follows the light at once. With it, SimulateEvents sub-steps every
   /// frame interval so that a · Δt stays small (see BandwidthMaxStepNs).
   double cutoff_hz = 0.0;
-  double hot_pixel_fraction = 0.0;  // fraction of pixels that are hot, in [0, 1]
+  double hot_pixel_fraction = 0.0;   // fraction of pixels that are hot, in [0, 1]
   double hot_pixel_rate_hz = 100.0;  // events per second of each hot pixel (random sign), > 0
-  uint64_t seed = 42;  // seeds the thresholds, the noise, the leak and the hot pixels
+  uint64_t seed = 42;                // seeds the thresholds, the noise, the leak and the hot pixels
 
   /// The longest sub-step of the low-pass, 2π · cutoff_hz · Δt <= 1/4, so that the filter's
   /// discrete steps follow its continuous response; only meaningful when cutoff_hz > 0.
@@ -150,9 +154,10 @@ class EventSimulator {
 /// is the video's. With light sources (`flicker` enabled) or a photoreceptor cutoff the sensor
 /// sees the scene at sub-steps of at most flicker.MaxStepNs() and options.BandwidthMaxStepNs(),
 /// evenly spaced in every frame interval: the frames' log intensities interpolated linearly,
-/// back to linear intensity, plus the light sources at that instant. Throws InvalidArgumentError for an empty video or invalid flicker options, when
-/// the expected noise, hot pixel and leak events over the whole video or the events produced
-/// exceed options.max_events, or as EventSimulator does.
+/// back to linear intensity, plus the light sources at that instant. Throws InvalidArgumentError
+/// for an empty video or invalid flicker options, when the expected noise, hot pixel and leak
+/// events over the whole video or the events produced exceed options.max_events, or as
+/// EventSimulator does.
 EventStream SimulateEvents(const Video& frames, const SimulatorOptions& options,
                            const FlickerOptions& flicker = FlickerOptions());
 

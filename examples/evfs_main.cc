@@ -424,12 +424,11 @@ int RunSimulate() {
   flicker.mains_depth = FLAGS_mains_depth;
   if (!FLAGS_mains_region_px.empty()) {
     const std::vector<double> region = ParseNumberList(FLAGS_mains_region_px, "--mains_region_px");
-    Require(region.size() == 4 && std::all_of(region.begin(), region.end(),
-                                              [](double v) {
-                                                return v >= 0.0 && v <= 65536.0 &&
-                                                       v == std::floor(v);
-                                              }),
-            "--mains_region_px must be X,Y,WIDTH,HEIGHT: four whole numbers in [0, 65536]");
+    Require(
+        region.size() == 4 &&
+            std::all_of(region.begin(), region.end(),
+                        [](double v) { return v >= 0.0 && v <= 65536.0 && v == std::floor(v); }),
+        "--mains_region_px must be X,Y,WIDTH,HEIGHT: four whole numbers in [0, 65536]");
     flicker.mains_x_px = static_cast<int>(region[0]);
     flicker.mains_y_px = static_cast<int>(region[1]);
     flicker.mains_width_px = static_cast<int>(region[2]);

@@ -31,9 +31,7 @@ Video ConstantFrames(int height, int width, const std::vector<double>& values,
 }
 
 /// Population standard deviation of `image`'s values.
-double StdDev(const Image& image) {
-  return std::sqrt((image - image.mean()).square().mean());
-}
+double StdDev(const Image& image) { return std::sqrt((image - image.mean()).square().mean()); }
 
 TEST(FrameEffectsOptions, DefaultsChangeNothingAndBadValuesAreNamed) {
   FrameEffectsOptions options;
@@ -58,8 +56,8 @@ TEST(FrameEffectsOptions, DefaultsChangeNothingAndBadValuesAreNamed) {
 
   // Without effects and light sources the frames come back untouched, not quantised.
   const Video video = ConstantFrames(3, 5, {0.123456, 0.654321}, 1000000);
-  const std::vector<RecordedFrame> frames = RecordFrames(video, FlickerOptions(),
-                                                         FrameEffectsOptions());
+  const std::vector<RecordedFrame> frames =
+      RecordFrames(video, FlickerOptions(), FrameEffectsOptions());
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_TRUE((frames[0].image == video.frame(0)).all());
   EXPECT_TRUE((frames[1].image == video.frame(1)).all());
@@ -145,10 +143,9 @@ TEST(RecordFrames, ExposureIsTheMeanOfTheSceneOverItsWindow) {
   Image mean = Image::Zero(4, 6);
   for (const int64_t t_ns : times) mean += SceneAt(video, FlickerOptions(), t_ns);
   mean /= static_cast<double>(times.size());
-  EXPECT_LT((ExposedScene(video, FlickerOptions(), 5000000, 15000000, 2500000) - mean)
-                .abs()
-                .maxCoeff(),
-            kMeanRounding);
+  EXPECT_LT(
+      (ExposedScene(video, FlickerOptions(), 5000000, 15000000, 2500000) - mean).abs().maxCoeff(),
+      kMeanRounding);
 }
 
 // A 100 Hz lamp at full depth: frames taken at an instant swing with the lamp, frames exposed

@@ -329,8 +329,7 @@ TEST(EventSimulator, LeakFiresOnEventsAtItsRate) {
   constexpr double kDurationS = 10.0;
   // Ten seconds of a still scene at 2 Hz: each pixel's leak reaches its threshold 20 times on
   // average.
-  const Video video =
-      ConstantVideo(Image::Constant(kSide, kSide, 0.5), 11, kNanosecondsPerSecond);
+  const Video video = ConstantVideo(Image::Constant(kSide, kSide, 0.5), 11, kNanosecondsPerSecond);
   SimulatorOptions options;
   options.leak_rate_hz = kLeakHz;
   const EventStream events = SimulateEvents(video, options);
@@ -380,8 +379,7 @@ TEST(EventSimulator, BlinkingLedFiresAtItsFrequency) {
   ASSERT_GT(events.size(), 0u);
   std::vector<std::vector<int8_t>> polarities(24 * 32);
   for (size_t i = 0; i < events.size(); ++i) {
-    ASSERT_TRUE(InLedDisc(flicker, events.x(i), events.y(i)))
-        << events.x(i) << "," << events.y(i);
+    ASSERT_TRUE(InLedDisc(flicker, events.x(i), events.y(i))) << events.x(i) << "," << events.y(i);
     polarities[events.y(i) * 32 + events.x(i)].push_back(events.polarity(i));
   }
   const double duration_s = NanosecondsToSeconds(video.timestamp_ns(kNumFrames - 1));
