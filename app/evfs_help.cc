@@ -27,8 +27,12 @@ ProgramHelp MakeEvfsHelp() {
        "uniform rate: OUT/frames, timestamps.txt, summary.json and video.mp4."},
       {"denoise", "--in=RECONSTRUCTION_DIR --out=DIR [--denoiser=FILE.onnx]",
        "Apply the residual denoiser (paper §3.4) to every frame of an earlier reconstruction."},
-      {"simulate", "--frames=DIR --out=DIR [--threshold_pos=0.2 --threshold_neg=0.2 --seed=42]",
-       "Simulate the events of a sequence of frames, written as a data folder."},
+      {"simulate",
+       "--frames=DIR --out=DIR [--threshold_pos=0.2 --threshold_neg=0.2 --seed=42] [sensor "
+       "effects, light sources and frame effects]",
+       "Simulate the events of a sequence of frames, written as a data folder; optionally with "
+       "leak, hot pixels, a photoreceptor bandwidth, a blinking LED, a mains lamp and the "
+       "frames' exposure, saturation and noise (all off by default)."},
       {"convert", "--data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR",
        "Convert a recording between a data folder, HDF5 and AEDAT 4."},
       {"demo", "--out=DIR",
