@@ -83,7 +83,9 @@ struct SimulatorOptions {
 ///
 /// Leak: each pixel leaks at its own rate, drawn once from N(leak_rate_hz, leak_jitter_fraction ·
 /// leak_rate_hz) clamped at 0, and starts (at Reset) a uniformly drawn part of the way to its
-/// first leak event, so that pixels under constant light do not fire in step. The leak moves the
+/// first leak event, so that pixels under constant light do not fire in step. That head start
+/// is an offset of up to one C_pos between L and the reference, so a pixel's first signal event
+/// after Reset also comes early (ON) or late (OFF) by up to one threshold. The leak moves the
 /// reference continuously and events are timed where L minus the moving reference crosses ±C.
 ///
 /// Hot pixels: round(hot_pixel_fraction · pixels) distinct pixels, drawn once, each a Poisson
