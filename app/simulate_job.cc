@@ -1,6 +1,7 @@
 #include "app/simulate_job.h"
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -11,9 +12,12 @@
 namespace evfs {
 
 SimulateSummary SimulateRecording(const std::string& frames_path, const SimulatorOptions& options,
-                                  const std::string& out_folder) {
+                                  const std::string& out_folder, const FlickerOptions& flicker,
+                                  const FrameEffectsOptions& frame_effects) {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
+  if (!flicker.IsValid(&error)) throw InvalidArgumentError("light sources: " + error);
+  if (!frame_effects.IsValid(&error)) throw InvalidArgumentError("frame effects: " + error);
   const std::unique_ptr<DataSource> source = DataSource::Open(frames_path);
   const std::vector<FrameInfo>& frames = source->frames();
   if (frames.size() < 2) {
@@ -29,8 +33,20 @@ SimulateSummary SimulateRecording(const std::string& frames_path, const Simulato
     images.push_back(source->ReadImage(static_cast<int>(i)));
     video.AppendFrame(images.back(), frames[i].t_ns);
   }
-  const EventStream events = SimulateEvents(video, options);
-  WriteDataFolder(out_folder, events, frames, images);
+  const EventStream events = SimulateEvents(video, options, flicker);
+  std::vector<FrameInfo> written = frames;
+  if (flicker.enabled() || frame_effects.enabled()) {
+    std::vector<RecordedFrame> recorded = RecordFrames(video, flicker, frame_effects);
+    for (size_t i = 0; i < frames.size(); ++i) {
+      images[i] = std::move(recorded[i].image);
+      if (recorded[i].has_exposure) {
+        written[i].has_exposure = true;
+        written[i].exposure_begin_ns = recorded[i].exposure_begin_ns;
+        written[i].exposure_end_ns = recorded[i].exposure_end_ns;
+      }
+    }
+  }
+  WriteDataFolder(out_folder, events, written, images);
 
   SimulateSummary summary;
   summary.events = static_cast<int64_t>(events.size());

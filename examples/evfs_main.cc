@@ -7,6 +7,7 @@
 //                    --preview] [solver and model flags]
 //   evfs denoise     --in=RECONSTRUCTION_DIR --out=DIR [--denoiser=FILE.onnx]
 //   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
+//                    [sensor effects, light sources and frame effects]
 //   evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR
 //   evfs demo        --out=DIR
 //
@@ -44,6 +45,8 @@
 #include "core/time.h"
 #include "core/version.h"
 #include "events/binning.h"
+#include "events/flicker.h"
+#include "events/frame_effects.h"
 #include "events/simulator.h"
 #include "io/aedat4.h"
 #include "io/data_source.h"
@@ -75,7 +78,8 @@ DEFINE_int32(truth, -1, "Frame to score the reconstruction against (PSNR, SSIM);
 DEFINE_string(mode, "", "interpolate | predict | deblur.");
 DEFINE_double(exposure_s, 0.0,
               "deblur: exposure around the frame's timestamp, when the data "
-              "has no exposures.txt.");
+              "has no exposures.txt. simulate: the written frames' exposure, each the mean of "
+              "the scene over it (with exposures.txt); 0: the scene at the timestamp.");
 DEFINE_double(fps, 0.0,
               "Resample the latent video to this uniform frame rate; 0 writes the "
               "latent frames themselves.");
@@ -286,6 +290,44 @@ DEFINE_double(refractory_s, 0.0, "simulate: refractory period in seconds.");
 DEFINE_double(noise_rate_hz, evfs::SimulatorOptions().noise_rate_hz,
               "simulate: background noise events per pixel per second.");
 DEFINE_uint64(seed, evfs::SimulatorOptions().seed, "simulate: random seed.");
+DEFINE_double(leak_rate_hz, evfs::SimulatorOptions().leak_rate_hz,
+              "simulate: leak (ON) events per pixel per second (v2e's default: 0.1); 0: none.");
+DEFINE_double(leak_jitter_fraction, evfs::SimulatorOptions().leak_jitter_fraction,
+              "simulate: per-pixel spread of the leak rate, a fraction of it (v2e).");
+DEFINE_double(cutoff_hz, evfs::SimulatorOptions().cutoff_hz,
+              "simulate: photoreceptor cutoff frequency at full intensity in Hz, falling with "
+              "intensity (v2e); 0: none.");
+DEFINE_double(hot_pixel_fraction, evfs::SimulatorOptions().hot_pixel_fraction,
+              "simulate: fraction of pixels that are hot, in [0, 1].");
+DEFINE_double(hot_pixel_rate_hz, evfs::SimulatorOptions().hot_pixel_rate_hz,
+              "simulate: events per second of each hot pixel (random polarity).");
+DEFINE_double(flicker_led_hz, evfs::FlickerOptions().led_hz,
+              "simulate: a blinking LED (square wave) at this frequency in Hz; 0: none. Needs "
+              "--flicker_led_xy_px.");
+DEFINE_string(flicker_led_xy_px, "", "simulate: the LED disc's centre 'X,Y' in pixels.");
+DEFINE_double(flicker_led_radius_px, evfs::FlickerOptions().led_radius_px,
+              "simulate: the LED disc's radius in pixels.");
+DEFINE_double(flicker_led_intensity, evfs::FlickerOptions().led_intensity,
+              "simulate: intensity the lit LED adds (1: white; above 1 saturates the frames).");
+DEFINE_double(flicker_led_duty, evfs::FlickerOptions().led_duty,
+              "simulate: fraction of each LED period it is lit, in (0, 1).");
+DEFINE_double(mains_hz, evfs::FlickerOptions().mains_hz,
+              "simulate: a mains lamp's flicker frequency in Hz (100 on 50 Hz mains, 120 on "
+              "60 Hz); 0: none.");
+DEFINE_double(mains_depth, evfs::FlickerOptions().mains_depth,
+              "simulate: the lamp's modulation depth m in [0, 1]: intensity times 1 + m sin(2 pi "
+              "f t).");
+DEFINE_string(mains_region_px, "",
+              "simulate: the region 'X,Y,WIDTH,HEIGHT' in pixels the lamp lights; empty: the "
+              "whole frame.");
+DEFINE_double(frame_gain, evfs::FrameEffectsOptions().gain,
+              "simulate: gain on the written frames before they clip at white (saturation).");
+DEFINE_double(read_noise_dn, evfs::FrameEffectsOptions().read_noise_dn,
+              "simulate: std dev of the frames' read noise in 8-bit DN.");
+DEFINE_double(fpn_offset_dn, evfs::FrameEffectsOptions().fpn_offset_dn,
+              "simulate: std dev of the frames' per-pixel offset (fixed pattern) in 8-bit DN.");
+DEFINE_double(fpn_gain_sigma, evfs::FrameEffectsOptions().fpn_gain_sigma,
+              "simulate: std dev of the frames' per-pixel relative gain (fixed pattern).");
 
 namespace evfs {
 namespace {
@@ -347,26 +389,6 @@ int RunConvert() {
   return 0;
 }
 
-int RunSimulate() {
-  Require(!FLAGS_frames.empty() && !FLAGS_out.empty(), "simulate needs --frames=DIR and --out=DIR");
-  SimulatorOptions options;
-  options.contrast_threshold_pos = FLAGS_threshold_pos;
-  options.contrast_threshold_neg = FLAGS_threshold_neg;
-  options.threshold_sigma = FLAGS_threshold_sigma;
-  options.refractory_period_ns = SecondsToNanoseconds(FLAGS_refractory_s);
-  options.noise_rate_hz = FLAGS_noise_rate_hz;
-  options.seed = FLAGS_seed;
-  std::string error;
-  if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
-  OutputTarget out(OutputFromFlags("simulate", FLAGS_frames));
-  const SimulateSummary summary = SimulateRecording(FLAGS_frames, options, out.staging());
-  out.Commit();
-  std::printf("simulated %lld events over %d frames (%dx%d) into %s\n",
-              static_cast<long long>(summary.events), summary.frames, summary.width, summary.height,
-              out.path().c_str());
-  return 0;
-}
-
 // "0.2,0.1" → {0.2, 0.1}; "" → {}. Throws InvalidArgumentError naming `flag` for a non-number.
 std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
   std::vector<double> numbers;
@@ -386,6 +408,70 @@ std::vector<double> ParseNumberList(const std::string& list, const char* flag) {
     numbers.push_back(value);
   }
   return numbers;
+}
+
+int RunSimulate() {
+  Require(!FLAGS_frames.empty() && !FLAGS_out.empty(), "simulate needs --frames=DIR and --out=DIR");
+  SimulatorOptions options;
+  options.contrast_threshold_pos = FLAGS_threshold_pos;
+  options.contrast_threshold_neg = FLAGS_threshold_neg;
+  options.threshold_sigma = FLAGS_threshold_sigma;
+  options.refractory_period_ns = SecondsToNanoseconds(FLAGS_refractory_s);
+  options.noise_rate_hz = FLAGS_noise_rate_hz;
+  options.seed = FLAGS_seed;
+  options.leak_rate_hz = FLAGS_leak_rate_hz;
+  options.leak_jitter_fraction = FLAGS_leak_jitter_fraction;
+  options.cutoff_hz = FLAGS_cutoff_hz;
+  options.hot_pixel_fraction = FLAGS_hot_pixel_fraction;
+  options.hot_pixel_rate_hz = FLAGS_hot_pixel_rate_hz;
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
+
+  FlickerOptions flicker;
+  flicker.led_hz = FLAGS_flicker_led_hz;
+  if (flicker.led_hz != 0.0 || !FLAGS_flicker_led_xy_px.empty()) {
+    const std::vector<double> xy = ParseNumberList(FLAGS_flicker_led_xy_px, "--flicker_led_xy_px");
+    Require(xy.size() == 2, "--flicker_led_hz needs --flicker_led_xy_px=X,Y (the LED's centre)");
+    Require(flicker.led_hz != 0.0, "--flicker_led_xy_px needs --flicker_led_hz");
+    flicker.led_x_px = xy[0];
+    flicker.led_y_px = xy[1];
+  }
+  flicker.led_radius_px = FLAGS_flicker_led_radius_px;
+  flicker.led_intensity = FLAGS_flicker_led_intensity;
+  flicker.led_duty = FLAGS_flicker_led_duty;
+  flicker.mains_hz = FLAGS_mains_hz;
+  flicker.mains_depth = FLAGS_mains_depth;
+  if (!FLAGS_mains_region_px.empty()) {
+    const std::vector<double> region = ParseNumberList(FLAGS_mains_region_px, "--mains_region_px");
+    Require(
+        region.size() == 4 &&
+            std::all_of(region.begin(), region.end(),
+                        [](double v) { return v >= 0.0 && v <= 65536.0 && v == std::floor(v); }),
+        "--mains_region_px must be X,Y,WIDTH,HEIGHT: four whole numbers in [0, 65536]");
+    flicker.mains_x_px = static_cast<int>(region[0]);
+    flicker.mains_y_px = static_cast<int>(region[1]);
+    flicker.mains_width_px = static_cast<int>(region[2]);
+    flicker.mains_height_px = static_cast<int>(region[3]);
+  }
+  if (!flicker.IsValid(&error)) throw InvalidArgumentError("light sources: " + error);
+
+  FrameEffectsOptions frame_effects;
+  frame_effects.exposure_s = FLAGS_exposure_s;
+  frame_effects.gain = FLAGS_frame_gain;
+  frame_effects.read_noise_dn = FLAGS_read_noise_dn;
+  frame_effects.fpn_offset_dn = FLAGS_fpn_offset_dn;
+  frame_effects.fpn_gain_sigma = FLAGS_fpn_gain_sigma;
+  frame_effects.seed = FLAGS_seed;
+  if (!frame_effects.IsValid(&error)) throw InvalidArgumentError("frame effects: " + error);
+
+  OutputTarget out(OutputFromFlags("simulate", FLAGS_frames));
+  const SimulateSummary summary =
+      SimulateRecording(FLAGS_frames, options, out.staging(), flicker, frame_effects);
+  out.Commit();
+  std::printf("simulated %lld events over %d frames (%dx%d) into %s\n",
+              static_cast<long long>(summary.events), summary.frames, summary.width, summary.height,
+              out.path().c_str());
+  return 0;
 }
 
 // The request of the reconstruct flags; `with_mode` false for `video`, which has no --mode.

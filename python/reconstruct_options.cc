@@ -291,6 +291,12 @@ const std::vector<Option<S>>& SimulateOptionTable() {
          s->refractory_period_ns = SecondsToNanoseconds(ToDouble("refractory_s", v));
        }},
       DoubleOption<S>("noise_rate_hz", [](S& s) -> double& { return s.noise_rate_hz; }),
+      DoubleOption<S>("leak_rate_hz", [](S& s) -> double& { return s.leak_rate_hz; }),
+      DoubleOption<S>("leak_jitter_fraction",
+                      [](S& s) -> double& { return s.leak_jitter_fraction; }),
+      DoubleOption<S>("cutoff_hz", [](S& s) -> double& { return s.cutoff_hz; }),
+      DoubleOption<S>("hot_pixel_fraction", [](S& s) -> double& { return s.hot_pixel_fraction; }),
+      DoubleOption<S>("hot_pixel_rate_hz", [](S& s) -> double& { return s.hot_pixel_rate_hz; }),
       {"seed", [](const S& s) { return py::cast(s.seed); },
        [](py::handle v, S* s) {
          s->seed =

@@ -314,7 +314,13 @@ def same_default(kind, text, value):
 # without files and a terminal.
 RECONSTRUCT_ARGUMENTS = {"data", "mode", "first", "last", "truth", "out", "overwrite",
                          "progress", "progress_interval_s"}
-SIMULATE_ARGUMENTS = {"frames", "out", "overwrite", "progress_interval_s"}
+# evfs.simulate returns the events of the frames as given: the light sources and the frame
+# effects of `evfs simulate` (which writes the frames it records) are the command's alone.
+SIMULATE_ARGUMENTS = {"frames", "out", "overwrite", "progress_interval_s", "exposure_s",
+                      "flicker_led_hz", "flicker_led_xy_px", "flicker_led_radius_px",
+                      "flicker_led_intensity", "flicker_led_duty", "mains_hz", "mains_depth",
+                      "mains_region_px", "frame_gain", "read_noise_dn", "fpn_offset_dn",
+                      "fpn_gain_sigma"}
 
 
 @pytest.mark.parametrize("command,defaults,arguments", [

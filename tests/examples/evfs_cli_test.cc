@@ -73,6 +73,41 @@ TEST(EvfsCli, SimulateWritesAFolderThatInfoReads) {
   EXPECT_NE(info.output.find("collision frames"), std::string::npos);
 }
 
+// Without effects the frames are written as read; with an exposure, exposures.txt is written
+// and read back by info; the light sources and effects are flags with clear errors.
+TEST(EvfsCli, SimulateEffectsWriteExposuresAndCheckTheirFlags) {
+  EVFS_REQUIRE_SHARED_DATA(data);
+  const std::string scratch = test::ScratchDir("simulate_effects");
+  const std::string frames = data + "/nfs_basketball_7";
+  const CommandResult plain =
+      RunEvfs("simulate --frames=" + frames + " --out=" + scratch + "/plain");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const Image input = ReadGreyImage(frames + "/frames/frame_00000003.png");
+  EXPECT_TRUE((ReadGreyImage(scratch + "/plain/frames/frame_00000003.png") == input).all());
+
+  const CommandResult exposed =
+      RunEvfs("simulate --frames=" + frames + " --out=" + scratch +
+              "/exposed --exposure_s=0.01 --flicker_led_hz=500 --flicker_led_xy_px=50,60 "
+              "--read_noise_dn=1");
+  ASSERT_EQ(exposed.exit_code, 0) << exposed.output;
+  const std::string exposures = ReadFile(scratch + "/exposed/exposures.txt");
+  // Frame 1 at 4.166667 ms: its 10 ms window is cut at the first frame, t = 0.
+  EXPECT_NE(exposures.find("frames/frame_00000001.png 0.000000000 0.009166667"), std::string::npos)
+      << exposures;
+  EXPECT_FALSE((ReadGreyImage(scratch + "/exposed/frames/frame_00000003.png") == input).all());
+  const auto source = DataSource::Open(scratch + "/exposed");
+  ASSERT_EQ(source->frames().size(), 20u);
+  EXPECT_TRUE(source->frames()[5].has_exposure);
+
+  for (const char* flags : {"--flicker_led_hz=500", "--flicker_led_xy_px=3,4",
+                            "--mains_hz=100 --mains_depth=2", "--mains_region_px=1,2,3",
+                            "--read_noise_dn=-1", "--hot_pixel_fraction=2", "--exposure_s=-1"}) {
+    const CommandResult bad =
+        RunEvfs("simulate --frames=" + frames + " --out=" + scratch + "/bad " + flags);
+    EXPECT_EQ(bad.exit_code, 2) << flags << ": " << bad.output;
+  }
+}
+
 TEST(EvfsCli, ConvertRoundTripIsByteIdentical) {
   EVFS_REQUIRE_SHARED_DATA(data);
   const std::string scratch = test::ScratchDir("convert");
