@@ -78,6 +78,7 @@ ProgramHelp MakeEvfsHelp() {
       {"max_latent_voxels", "binning", "info reconstruct video"},
       {"hot_pixel_factor", "binning", "info reconstruct video"},
       {"saturation_level", "binning", "info reconstruct video"},
+      {"leave_out_saturated", "binning", "info reconstruct video"},
       {"flicker_min_reversals", "binning", "info reconstruct video"},
       {"noise_filter_ms", "binning", "info reconstruct video"},
       {"stacked_frames", "binning", "info reconstruct video"},

@@ -83,11 +83,11 @@ bool IsOwnWorkFolder(const fs::path& folder) {
 }
 
 // Whether `relative` (inside a work folder, '/'-separated) is a path a video run writes there:
-// the marker, frames/ and windows/ with their files, and each file's temporary name.
+// the marker, frames/, confidence/ and windows/ with their files, and each file's temporary name.
 bool IsWorkFolderPath(const std::string& relative, bool is_folder) {
-  if (is_folder) return relative == "frames" || relative == "windows";
+  if (is_folder) return relative == "frames" || relative == "confidence" || relative == "windows";
   static const std::regex kOwnFile(
-      R"((\.evfs-video-work|frames/[0-9]+(\.tmp)?\.png|windows/[0-9]+\.json)(\.tmp)?)");
+      R"((\.evfs-video-work|(frames|confidence)/[0-9]+(\.tmp)?\.png|windows/[0-9]+\.json)(\.tmp)?)");
   return std::regex_match(relative, kOwnFile);
 }
 
@@ -125,7 +125,9 @@ void RemoveWorkFolder(const fs::path& folder) {
     return;
   }
   for (const fs::path& file : own_files) fs::remove(file, error);
-  for (const char* sub : {"frames", "windows", ""}) fs::remove(folder / sub, error);  // if empty
+  for (const char* sub : {"frames", "confidence", "windows", ""}) {
+    fs::remove(folder / sub, error);  // if empty
+  }
 }
 
 // "a, b, c (and 4 more)".

@@ -128,13 +128,16 @@ DEFINE_double(hot_pixel_factor, evfs::BinningOptions().hot_pixel_factor,
               "often as the window's busy pixels (the busiest outside the top 1 %); 0 keeps "
               "every event.");
 DEFINE_double(saturation_level, evfs::BinningOptions().saturation_level,
-              "Leave out the events of pixels at or above this level (intensity in [0, 1]) in "
-              "any frame of the window: a saturated frame cannot show what they record, so the "
-              "frames govern there; above 1 keeps every event.");
+              "A frame pixel at or above this level (intensity in [0, 1]) is saturated "
+              "(--flicker_min_reversals, --leave_out_saturated); above 1: none is.");
+DEFINE_bool(leave_out_saturated, evfs::BinningOptions().leave_out_saturated,
+            "Leave out the events of pixels saturated in every frame of the window (the frames "
+            "cannot show what they record).");
 DEFINE_int32(flicker_min_reversals, evfs::BinningOptions().flicker_min_reversals,
              "Leave out the events of pixels whose events reverse polarity at least this many "
              "times in the window with almost no net change (a blinking LED, a mains-powered "
-             "lamp), so the frames govern there; 0 keeps them.");
+             "lamp), next to a pixel a frame shows saturated: the frames govern there; 0 keeps "
+             "them.");
 DEFINE_double(noise_filter_ms, evfs::BinningOptions().noise_filter_ms,
               "Leave out events that no neighbouring pixel confirms within this many ms "
               "(background-activity filter); 0 keeps every event.");
@@ -355,6 +358,7 @@ BinningOptions BinningFromFlags() {
   binning.max_latent_voxels = FLAGS_max_latent_voxels;
   binning.hot_pixel_factor = FLAGS_hot_pixel_factor;
   binning.saturation_level = FLAGS_saturation_level;
+  binning.leave_out_saturated = FLAGS_leave_out_saturated;
   binning.flicker_min_reversals = FLAGS_flicker_min_reversals;
   binning.noise_filter_ms = FLAGS_noise_filter_ms;
   binning.stacked.num_frames = FLAGS_stacked_frames;

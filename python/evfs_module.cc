@@ -308,6 +308,7 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   py::dict output;
   output["times"] = Seconds(result.output.timestamps_ns());
   output["frames"] = VideoArray(std::move(result.output), dtype);
+  output["confidence"] = VideoArray(std::move(result.confidence), dtype);
   output["summary"] = py::module_::import("json").attr("loads")(summary);
   return output;
 }
@@ -448,7 +449,9 @@ PYBIND11_MODULE(evfs, m) {
         "read() returns them; truth: a frame to score against (-1: none); options: a dict of the "
         "command line's flags (reconstruct_defaults()). Returns a dict: 'frames' (latent frames, "
         "frames x height x width of `dtype`: 'float32', or 'float64' for the solver's own "
-        "values), 'times' (float64 seconds) and 'summary' (summary.json as a dict).");
+        "values), 'times' (float64 seconds), 'confidence' (the predicted one-sigma error of every "
+        "pixel of 'frames', same shape and dtype, intensity units) and 'summary' (summary.json as "
+        "a dict).");
   m.def("simulate", &evfs::SimulateArrays, py::arg("frames"), py::arg("frame_times"),
         py::arg("options") = py::none(),
         "Simulates the events of a sequence of frames (at least 2; frames x height x width "

@@ -163,6 +163,8 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
                       [](R& s) -> double& { return s.request.binning.hot_pixel_factor; }),
       DoubleOption<R>("saturation_level",
                       [](R& s) -> double& { return s.request.binning.saturation_level; }),
+      BoolOption<R>("leave_out_saturated",
+                    [](R& s) -> bool& { return s.request.binning.leave_out_saturated; }),
       IntOption<R>("flicker_min_reversals",
                    [](R& s) -> int& { return s.request.binning.flicker_min_reversals; }),
       DoubleOption<R>("noise_filter_ms",

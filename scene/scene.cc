@@ -18,7 +18,8 @@ std::string VoxelCount(int64_t latent_frames, int64_t pixels) {
          " pixels = " + std::to_string(latent_frames * pixels) + " voxels";
 }
 
-// The pixels at or above `level` in any of `frames`, row-major and ascending.
+// The pixels at or above `level` in every one of `frames` (none when there are none),
+// row-major and ascending.
 std::vector<int32_t> SaturatedPixels(const std::vector<const Image*>& frames, int width, int height,
                                      double level) {
   std::vector<int32_t> saturated;
@@ -31,15 +32,44 @@ std::vector<int32_t> SaturatedPixels(const std::vector<const Image*>& frames, in
                                  std::to_string(width) + "x" + std::to_string(height));
     }
   }
+  if (frames.empty()) return saturated;
   for (int64_t p = 0; p < pixels; ++p) {
-    for (const Image* frame : frames) {
-      if (frame->data()[p] >= level) {
-        saturated.push_back(static_cast<int32_t>(p));
-        break;
-      }
-    }
+    const bool everywhere = std::all_of(frames.begin(), frames.end(), [&](const Image* frame) {
+      return frame->data()[p] >= level;
+    });
+    if (everywhere) saturated.push_back(static_cast<int32_t>(p));
   }
   return saturated;
+}
+
+// Pixels within this many pixels of a saturated frame pixel are near saturation: a bright light
+// blooms into the pixels around it, which see it flicker without reaching full scale.
+constexpr int kSaturationReachPx = 2;
+
+// The pixels of `pixels` (row-major, ascending) that lie within kSaturationReachPx of a pixel
+// at or above `level` in any of `frames`.
+std::vector<int32_t> NearSaturation(const std::vector<int32_t>& pixels,
+                                    const std::vector<const Image*>& frames, int width, int height,
+                                    double level) {
+  std::vector<int32_t> near;
+  if (pixels.empty() || level > 1.0) return near;
+  std::vector<uint8_t> saturated(static_cast<size_t>(width) * height, 0);
+  for (const Image* frame : frames) {
+    for (size_t p = 0; p < saturated.size(); ++p) saturated[p] |= frame->data()[p] >= level;
+  }
+  for (const int32_t pixel : pixels) {
+    const int x = pixel % width, y = pixel / width;
+    bool found = false;
+    for (int qy = std::max(0, y - kSaturationReachPx);
+         !found && qy <= std::min(height - 1, y + kSaturationReachPx); ++qy) {
+      for (int qx = std::max(0, x - kSaturationReachPx);
+           !found && qx <= std::min(width - 1, x + kSaturationReachPx); ++qx) {
+        found = saturated[static_cast<size_t>(qy) * width + qx] != 0;
+      }
+    }
+    if (found) near.push_back(pixel);
+  }
+  return near;
 }
 
 // The events in [begin_ns, end_ns) at `pixels` (row-major, ascending).
@@ -80,15 +110,20 @@ BinningPlan PlanAndFilter(const EventStream& events, int64_t begin_ns, int64_t e
   // Each rule takes the pixels the rules before it left, so that every pixel left out is
   // counted once.
   std::vector<int32_t> left_out = plan.activity.hot_pixels;
-  plan.saturated_pixels = Untaken(
-      SaturatedPixels(frames, events.width(), events.height(), binning.saturation_level), left_out);
+  if (binning.leave_out_saturated) {
+    plan.saturated_pixels =
+        Untaken(SaturatedPixels(frames, events.width(), events.height(), binning.saturation_level),
+                left_out);
+  }
   plan.saturated_pixel_events = EventsAt(events, begin_ns, end_ns, plan.saturated_pixels);
   std::vector<int32_t> merged;
   std::merge(left_out.begin(), left_out.end(), plan.saturated_pixels.begin(),
              plan.saturated_pixels.end(), std::back_inserter(merged));
   left_out.swap(merged);
   plan.flickering_pixels = Untaken(
-      FindFlickeringPixels(events, begin_ns, end_ns, binning.flicker_min_reversals), left_out);
+      NearSaturation(FindFlickeringPixels(events, begin_ns, end_ns, binning.flicker_min_reversals),
+                     frames, events.width(), events.height(), binning.saturation_level),
+      left_out);
   plan.flickering_pixel_events = EventsAt(events, begin_ns, end_ns, plan.flickering_pixels);
   merged.clear();
   std::merge(left_out.begin(), left_out.end(), plan.flickering_pixels.begin(),

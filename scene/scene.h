@@ -66,15 +66,22 @@ struct BinningOptions {
   /// stuck pixel neither multiplies the collision frames nor bends its own pixel; 0 keeps every
   /// event. 10 is more than twice the largest ratio in the shared DAVIS recordings (4.4).
   double hot_pixel_factor = 10.0;
-  /// Every method: a pixel at or above this level (intensity in [0, 1]) in any frame of the
-  /// window is saturated, and its events are left out. A saturated frame pixel cannot show the
-  /// changes its events record (a lamp or an LED brighter than the frame's full scale still
-  /// fires events), so the frames govern there; > 1 keeps every event. The default takes the
-  /// top two codes of an 8-bit frame.
+  /// Every method: a frame pixel at or above this level (intensity in [0, 1]) is saturated
+  /// (flicker_min_reversals, leave_out_saturated); > 1: none is. The default takes the top two
+  /// codes of an 8-bit frame.
   double saturation_level = 0.995;
+  /// Every method: leave out the events of pixels saturated in every frame of the window, where
+  /// the frames cannot show the changes the events record. Off by default: on the real
+  /// recordings it fires on, their events were still worth more than the frames (BENCHMARKS.md,
+  /// "Real recordings"); a saturated light that flickers is taken by flicker_min_reversals.
+  bool leave_out_saturated = false;
   /// Every method: pixels whose events reverse polarity at least this many times in the window
   /// with almost no net change flicker (FindFlickeringPixels: a blinking LED or a mains-powered
-  /// lamp), and their events are left out, so the frames govern there; 0 keeps them.
+  /// lamp). Where such a pixel lies within two pixels of one that a frame of the window shows at
+  /// or above saturation_level, the light is brighter than the frames can show and the events'
+  /// amplitude disagrees with them: its events are left out, so the frames govern there. A light
+  /// the frames show unsaturated keeps its events, which follow it as the frames do. 0 keeps
+  /// every flickering pixel's events.
   int flicker_min_reversals = 3;
   /// Every method: after the hot pixels, events that no neighbouring pixel confirms within this
   /// many milliseconds are left out as background activity (WithoutUnsupportedEvents); 0 keeps
@@ -115,11 +122,11 @@ struct BinningPlan {
 };
 
 /// Decides the binning of the events in [window_begin_ns, window_end_ns) from counts, after
-/// leaving out the events of hot, saturated (in any of `frames`, which may be empty) and
-/// flickering pixels. Throws InvalidArgumentError, naming the option to change, when the binning
-/// asked for would exceed binning.max_latent_voxels (explicit collision or stacked binning over
-/// it, or a sensor on which not even one latent step fits), for invalid options, for a frame of
-/// another size than the sensor, or as the binning functions do.
+/// leaving out the events of hot, saturated (with leave_out_saturated: in every one of `frames`,
+/// which may be empty) and flickering pixels. Throws InvalidArgumentError, naming the option to
+/// change, when the binning asked for would exceed binning.max_latent_voxels (explicit collision or
+/// stacked binning over it, or a sensor on which not even one latent step fits), for invalid
+/// options, for a frame of another size than the sensor, or as the binning functions do.
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
                         const BinningOptions& binning,
                         const std::vector<const Image*>& frames = {});

@@ -60,14 +60,17 @@ def quantize_like_png(frames):
     return (whole + (scaled - whole >= 0.5)).astype(np.uint16)
 
 
-def read_cli_reconstruction(folder):
-    """Frames (as the 16-bit values written) and times of an `evfs reconstruct` output."""
-    names = sorted(glob.glob(os.path.join(folder, "frames", "*.png")))
+def read_cli_reconstruction(folder, images_folder="frames"):
+    """Frames (as the 16-bit values written) and times of an `evfs reconstruct` output; with
+    images_folder="confidence", its confidence maps instead of its frames."""
+    names = sorted(glob.glob(os.path.join(folder, images_folder, "*.png")))
     # The frames are read back through evfs.read, as a data folder whose images.txt lists them.
     with open(os.path.join(folder, "images.txt"), "w") as images:
         for i, name in enumerate(names):
-            images.write(f"{i} frames/{os.path.basename(name)}\n")
+            images.write(f"{i} {images_folder}/{os.path.basename(name)}\n")
     recording = evfs.read(folder)
+    # Not left in the output: a later --overwrite would find a file evfs did not write.
+    os.remove(os.path.join(folder, "images.txt"))
     frames = np.rint(recording["frames"] * PNG_MAX).astype(np.uint16)
     times = []
     with open(os.path.join(folder, "timestamps.txt")) as lines:
@@ -226,6 +229,9 @@ def test_reconstruct_identical_to_cli(demo, tmp_path, mode, first, last):
     np.testing.assert_array_equal(quantize_like_png(result["frames"]), cli_frames)
     assert result["summary"]["mode"] == mode
     assert result["summary"]["latent_frames"] == cli_frames.shape[0]
+    cli_confidence, _ = read_cli_reconstruction(str(tmp_path / f"cli_{mode}"), "confidence")
+    assert result["confidence"].shape == result["frames"].shape
+    np.testing.assert_array_equal(quantize_like_png(result["confidence"]), cli_confidence)
 
 
 def test_reconstruct_deblur_with_options_identical_to_cli(demo, tmp_path):
@@ -311,12 +317,14 @@ def same_default(kind, text, value):
 
 
 # Flags of `evfs reconstruct` that are arguments of evfs.reconstruct, or that have no meaning
-# without files and a terminal.
+# without files and a terminal (--allow_outside_paths guards the frame paths of a recording's
+# images.txt; evfs.reconstruct takes arrays).
 RECONSTRUCT_ARGUMENTS = {"data", "mode", "first", "last", "truth", "out", "overwrite",
-                         "progress", "progress_interval_s"}
+                         "progress", "progress_interval_s", "allow_outside_paths"}
 # evfs.simulate returns the events of the frames as given: the light sources and the frame
 # effects of `evfs simulate` (which writes the frames it records) are the command's alone.
 SIMULATE_ARGUMENTS = {"frames", "out", "overwrite", "progress_interval_s", "exposure_s",
+                      "allow_outside_paths",
                       "flicker_led_hz", "flicker_led_xy_px", "flicker_led_radius_px",
                       "flicker_led_intensity", "flicker_led_duty", "mains_hz", "mains_depth",
                       "mains_region_px", "frame_gain", "read_noise_dn", "fpn_offset_dn",

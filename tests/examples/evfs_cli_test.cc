@@ -379,11 +379,8 @@ TEST(EvfsCli, OdditiesOfRealFilesAreAccepted) {
   test::WriteFile((data / "images.txt").string(),
                   "# t path\r\n1.0 images/a.png\r\n\n1.1 images/b.png");
   const fs::path out = scratch / "out";
-  // The random frames reach full scale at some pixels: --saturation_level=2 keeps every event,
-  // so that the count reads what was parsed.
-  const CommandResult run =
-      RunEvfs("reconstruct --data=" + data.string() + " --mode=interpolate --first=0 --last=1" +
-              " --saturation_level=2 --out=" + out.string());
+  const CommandResult run = RunEvfs("reconstruct --data=" + data.string() +
+                                    " --mode=interpolate --first=0 --last=1 --out=" + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(ReadFile(out / "summary.json").find("\"events\": 10,"), std::string::npos);
 }

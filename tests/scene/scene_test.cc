@@ -316,8 +316,9 @@ std::pair<int, int> BusiestPixel(const EventStream& events) {
   return {p % events.width(), p / events.width()};
 }
 
-// A frame pixel at full scale cannot show what its events record: they are left out and
-// counted, and with a level above 1 they are kept.
+// With leave_out_saturated, a pixel at full scale in every frame cannot show what its events
+// record: they are left out and counted. Saturated in one frame only, its events time an edge
+// and are kept; with a level above 1 every event is kept.
 TEST(Scene, SaturatedPixelLeavesItsEventsToTheFrames) {
   const test::SyntheticRecording recording;
   const int64_t begin_ns = recording.rendered.timestamp_ns(0);
@@ -325,12 +326,20 @@ TEST(Scene, SaturatedPixelLeavesItsEventsToTheFrames) {
   const auto [x, y] = BusiestPixel(recording.events);
   const int64_t at_pixel = EventsAtPixel(recording.events, x, y, begin_ns, end_ns);
   ASSERT_GT(at_pixel, 0);
+  TimedFrame first = recording.Sharp(0);
   TimedFrame last = recording.Sharp(20);
   last.image(y, x) = 1.0;
   const Scene clean = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
                                              recording.events, BinningOptions());
-  const Scene scene =
-      MakeInterpolationScene(recording.Sharp(0), last, recording.events, BinningOptions());
+  BinningOptions rule;
+  rule.leave_out_saturated = true;
+  const Scene one_side = MakeInterpolationScene(recording.Sharp(0), last, recording.events, rule);
+  EXPECT_TRUE(one_side.saturated_pixels.empty());
+  EXPECT_EQ(one_side.num_events, clean.num_events);
+  first.image(y, x) = 1.0;
+  EXPECT_TRUE(MakeInterpolationScene(first, last, recording.events, BinningOptions())
+                  .saturated_pixels.empty());  // the rule is off by default
+  const Scene scene = MakeInterpolationScene(first, last, recording.events, rule);
   EXPECT_TRUE(clean.saturated_pixels.empty());
   ASSERT_EQ(scene.saturated_pixels.size(), 1u);
   EXPECT_EQ(scene.saturated_pixels[0], y * recording.events.width() + x);
@@ -341,9 +350,9 @@ TEST(Scene, SaturatedPixelLeavesItsEventsToTheFrames) {
     fired += std::abs(scene.events.value(k, y, x));
   EXPECT_EQ(fired, 0.0);
 
-  BinningOptions keep;
+  BinningOptions keep = rule;
   keep.saturation_level = 1.5;
-  const Scene kept = MakeInterpolationScene(recording.Sharp(0), last, recording.events, keep);
+  const Scene kept = MakeInterpolationScene(first, last, recording.events, keep);
   EXPECT_TRUE(kept.saturated_pixels.empty());
   EXPECT_EQ(kept.num_events, clean.num_events);
 
@@ -354,9 +363,11 @@ TEST(Scene, SaturatedPixelLeavesItsEventsToTheFrames) {
   EXPECT_NE(error.find("saturation_level"), std::string::npos) << error;
 }
 
-// A light blinking at one pixel (alternating bursts, far fewer events than a hot pixel's) is
-// left to the frames; the moving shapes' own pixels are not taken for flicker.
-TEST(Scene, FlickeringPixelLeavesItsEventsToTheFrames) {
+// A light blinking at one pixel (alternating bursts, far fewer events than a hot pixel's) next
+// to where the frame saturates is brighter than the frame can show: left to the frames. The same
+// light with the frame unsaturated keeps its events, and the moving shapes' own pixels are never
+// taken for flicker.
+TEST(Scene, FlickeringPixelNextToSaturationLeavesItsEventsToTheFrames) {
   const test::SyntheticRecording recording;
   const int64_t begin_ns = recording.rendered.timestamp_ns(0);
   const int64_t end_ns = recording.rendered.timestamp_ns(20);
@@ -366,7 +377,13 @@ TEST(Scene, FlickeringPixelLeavesItsEventsToTheFrames) {
   const Scene clean =
       MakePredictionScene(recording.Sharp(0), end_ns, recording.events, BinningOptions());
   EXPECT_TRUE(clean.flickering_pixels.empty());
-  const Scene scene = MakePredictionScene(recording.Sharp(0), end_ns, lit, BinningOptions());
+  const Scene unsaturated = MakePredictionScene(recording.Sharp(0), end_ns, lit, BinningOptions());
+  EXPECT_TRUE(unsaturated.flickering_pixels.empty());
+  EXPECT_EQ(unsaturated.num_events, clean.num_events + 12);
+
+  TimedFrame glaring = recording.Sharp(0);
+  glaring.image(y, x + 2) = 1.0;  // two pixels away: within reach of the light's glare
+  const Scene scene = MakePredictionScene(glaring, end_ns, lit, BinningOptions());
   EXPECT_TRUE(scene.hot_pixels.empty());
   ASSERT_EQ(scene.flickering_pixels.size(), 1u);
   EXPECT_EQ(scene.flickering_pixels[0], y * lit.width() + x);
@@ -375,7 +392,11 @@ TEST(Scene, FlickeringPixelLeavesItsEventsToTheFrames) {
 
   BinningOptions keep;
   keep.flicker_min_reversals = 0;
-  EXPECT_TRUE(MakePredictionScene(recording.Sharp(0), end_ns, lit, keep).flickering_pixels.empty());
+  EXPECT_TRUE(MakePredictionScene(glaring, end_ns, lit, keep).flickering_pixels.empty());
+  glaring.image(y, x + 2) = 0.5;
+  glaring.image(y, x + 3) = 1.0;  // three pixels away: out of reach
+  EXPECT_TRUE(
+      MakePredictionScene(glaring, end_ns, lit, BinningOptions()).flickering_pixels.empty());
 }
 
 #if !defined(__SANITIZE_ADDRESS__) && !EVFS_HAS_FEATURE(address_sanitizer) && \
