@@ -12,8 +12,8 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "app/frame_consistency.h"
@@ -82,13 +82,33 @@ bool IsOwnWorkFolder(const fs::path& folder) {
   return title == kWorkMarkerTitle;
 }
 
+// Whether `name` is a run of decimal digits followed by `suffix`.
+bool DigitsThen(std::string_view name, std::string_view suffix) {
+  if (name.size() <= suffix.size() || name.substr(name.size() - suffix.size()) != suffix) {
+    return false;
+  }
+  const std::string_view digits = name.substr(0, name.size() - suffix.size());
+  return std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
 // Whether `relative` (inside a work folder, '/'-separated) is a path a video run writes there:
 // the marker, frames/, confidence/ and windows/ with their files, and each file's temporary name.
 bool IsWorkFolderPath(const std::string& relative, bool is_folder) {
   if (is_folder) return relative == "frames" || relative == "confidence" || relative == "windows";
-  static const std::regex kOwnFile(
-      R"((\.evfs-video-work|(frames|confidence)/[0-9]+(\.tmp)?\.png|windows/[0-9]+\.json)(\.tmp)?)");
-  return std::regex_match(relative, kOwnFile);
+  std::string_view name = relative;
+  constexpr std::string_view kTemporary = ".tmp";
+  if (name.size() > kTemporary.size() && name.substr(name.size() - kTemporary.size()) == kTemporary)
+    name.remove_suffix(kTemporary.size());
+  if (name == kWorkMarkerFile) return true;
+  for (const std::string_view folder : {"frames/", "confidence/"}) {
+    if (name.substr(0, folder.size()) == folder) {
+      const std::string_view file = name.substr(folder.size());
+      return DigitsThen(file, ".png") || DigitsThen(file, ".tmp.png");
+    }
+  }
+  constexpr std::string_view kWindows = "windows/";
+  return name.substr(0, kWindows.size()) == kWindows &&
+         DigitsThen(name.substr(kWindows.size()), ".json");
 }
 
 // The paths in a work folder that a video run does not write ("REL", "REL/" for a folder),
