@@ -7,7 +7,7 @@
 // line; a crash is one line and a non-zero status.
 //
 // libhdf5 1.10 dereferences offsets read from the file without checking them, so some corrupt
-// .h5 files crash it (README.md, Robustness) where no error can be caught: a crash on a thread
+// .h5 files crash it (docs/robustness.md) where no error can be caught: a crash on a thread
 // inside libhdf5 reading the user's file (io/hdf5_io.h, ScopedLibhdf5Read) is reported as that
 // file's fault. Every other crash, and every failed CHECK, is a bug of evfs': an internal error.
 #ifndef EVFS_APP_CRASH_GUARD_H_

@@ -1,4 +1,4 @@
-// Where the solver starts (DESIGN.md §1 table): the blend of the frames, or the classical
+// Where the solver starts (docs/design.md §1 table): the blend of the frames, or the classical
 // event-based estimate of baselines/ for the case (event integration from a sharp frame, the
 // Event-based Double Integral for a blurred one).
 #ifndef EVFS_APP_INITIALIZATION_H_

@@ -117,7 +117,7 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request, const Dat
 void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* result,
                          const std::string& folder);
 
-/// summary.json's text (DESIGN.md §8).
+/// summary.json's text (docs/guide.md).
 std::string SummaryJson(const ReconstructRequest& request, const ReconstructResult& result);
 
 }  // namespace evfs

@@ -7,8 +7,8 @@
 //
 // Every gap between consecutive selected frames is an interpolation window. A frame whose
 // exposure is known (exposures.txt, or --exposure_s) and at least `min_blur_exposure_s` long is
-// observed over that exposure (the mean of the latent frames inside it, DESIGN.md §1), so it is
-// deblurred within each window that holds it; such a window reads the events of both frames'
+// observed over that exposure (the mean of the latent frames inside it, docs/design.md §1), so it
+// is deblurred within each window that holds it; such a window reads the events of both frames'
 // whole exposures. A sharp frame is observed at its timestamp. After the recording's last frame,
 // a prediction window runs up to the last event. A single blurred frame selected alone is one
 // deblur window. Windows own half-open output intervals that tile [t_first, t_end], so every

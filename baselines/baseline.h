@@ -1,5 +1,5 @@
-// The classical baselines of DESIGN.md §5 behind one interface, so that the command line and the
-// benchmarks run them on the same Scene as the solver and compare their Videos frame by frame:
+// The classical baselines of docs/design.md §5 behind one interface, so that the command line and
+// the benchmarks run them on the same Scene as the solver and compare their Videos frame by frame:
 //
 //   name       method                                                        cases
 //   blend      linear blend in time of the frames (InitializeLatentVideo)     two or more frames

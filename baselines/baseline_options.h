@@ -1,4 +1,4 @@
-// The parameters of every classical baseline (DESIGN.md §5), in one struct so that a command
+// The parameters of every classical baseline (docs/design.md §5), in one struct so that a command
 // line can fill it from flags and a summary can print it. Each field says which methods read it.
 #ifndef EVFS_BASELINES_BASELINE_OPTIONS_H_
 #define EVFS_BASELINES_BASELINE_OPTIONS_H_

@@ -6,7 +6,7 @@
 // to t. So B = L(f)/T ∫ exp(c E(t)) dt (the double integral: of events, then over time), and
 //   L(t) = B · exp(c E(t)) / mean_{s in exposure} exp(c E(s))
 // for any t, inside the exposure or not. On the scene's timeline the mean is over the latent
-// frames of the exposure, the frame model of DESIGN.md §1, so mean(L_a … L_b) = B exactly.
+// frames of the exposure, the frame model of docs/design.md §1, so mean(L_a … L_b) = B exactly.
 // E(t) is the cumulative count of the scene's event frames (CumulativeEventCount: events at the
 // end of their latent step, stacked counts spread evenly over their steps).
 //

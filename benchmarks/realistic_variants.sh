@@ -125,8 +125,8 @@ if __name__ == "__main__":
 PY
 
 # The variants: name, then the simulate flags. The LED sits a quarter of the way into the frame
-# (its centre and radius are set per clip below); the parameters are the literature's (README
-# "Simulator: real sensor effects").
+# (its centre and radius are set per clip below); the parameters are the literature's (docs/model.md,
+# "Simulator defaults").
 variant_flags() {
   local led="--flicker_led_hz=1000 --flicker_led_xy_px=$1,$2 --flicker_led_radius_px=$3"
   local mains="--mains_hz=100 --mains_depth=0.3"

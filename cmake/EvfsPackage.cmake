@@ -1,7 +1,7 @@
 # The installed CMake package: `cmake --install BUILD --prefix PREFIX` puts the libraries in
 # PREFIX/lib, their headers in PREFIX/include/evfs/MODULE, the `evfs` program in PREFIX/bin and
 # evfsConfig.cmake, evfsConfigVersion.cmake and evfsTargets.cmake in PREFIX/lib/cmake/evfs, so
-# that another project's find_package(evfs) gives the evfs:: targets (README.md, "Use from
+# that another project's find_package(evfs) gives the evfs:: targets (docs/guide.md, "Use from
 # CMake"). Included by the top-level CMakeLists.txt after every module.
 include(CMakePackageConfigHelpers)
 set(EVFS_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/evfs")

@@ -1,5 +1,5 @@
 // Event frames: events binned onto the pixel grid, each frame tied to a span of the latent
-// timeline (DESIGN.md §2). Frame k models the change from latent frame `latent_first` to
+// timeline (docs/design.md §2). Frame k models the change from latent frame `latent_first` to
 // `latent_last` (latent_last > latent_first).
 #ifndef EVFS_CORE_EVENT_FRAMES_H_
 #define EVFS_CORE_EVENT_FRAMES_H_

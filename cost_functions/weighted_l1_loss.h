@@ -1,6 +1,6 @@
 // cost(r) = weight * (sqrt(a^2 + |r|^2) - a)
 //
-// The l1 penalties of the objective (paper Eqs. 3-5, DESIGN.md §1) made smooth for Ceres: the
+// The l1 penalties of the objective (paper Eqs. 3-5, docs/design.md §1) made smooth for Ceres: the
 // pseudo-Huber form of weight * |r| with smoothing scale a. It tends to weight * |r| for
 // |r| >> a and to weight * |r|^2 / (2 a) near 0.
 #ifndef EVFS_COST_FUNCTIONS_WEIGHTED_L1_LOSS_H_

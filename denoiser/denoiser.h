@@ -1,4 +1,4 @@
-// The residual denoiser of the paper's second stage (§3.4, DESIGN.md §4): a fixed-weight
+// The residual denoiser of the paper's second stage (§3.4, docs/design.md §4): a fixed-weight
 // convolutional network R, loaded from an ONNX file and run with OpenCV's DNN module, predicts
 // the artefact of a reconstructed frame H; the denoised frame is H − R(H).
 //

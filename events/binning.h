@@ -1,4 +1,4 @@
-// Binning events into event frames and the latent timeline (paper §3.3, DESIGN.md §2).
+// Binning events into event frames and the latent timeline (paper §3.3, docs/design.md §2).
 //
 // Both strategies take the events with t_begin_ns <= t < t_end_ns (a half-open window, like
 // EventStream::Slice) and return EventFrames whose latent timestamps start at t_begin_ns and end

@@ -1,4 +1,4 @@
-// evfs — event-driven video frame synthesis from the command line (DESIGN.md §8).
+// evfs — event-driven video frame synthesis from the command line (docs/guide.md).
 //
 //   evfs info        --data=DIR [--first=I --last=J]
 //   evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]
@@ -240,15 +240,16 @@ DEFINE_string(denoise, "auto",
               "reconstruct: none | once (the residual denoiser after the solve) | pnp (plug & "
               "play: ADMM between the Ceres problem and the denoiser, ceres_lm only) | auto "
               "(once when --denoiser is given; otherwise none: the shipped network, trained on "
-              "simulated events, softens real recordings; README \"Residual denoiser\").");
+              "simulated events, softens real recordings; BENCHMARKS.md \"Residual denoiser\").");
 DEFINE_string(denoiser, "",
               "The denoiser's ONNX weights (reconstruct, denoise); empty: the shipped "
               "models/evfs_denoiser.onnx.");
-DEFINE_bool(denoise_consistency, evfs::DenoiseRequest().consistency,
-            "--denoise=once: keep the recording's own frames as the solve matched them (the "
-            "part of the denoiser's correction that would change a frame's exposure mean is "
-            "taken out; README \"Residual denoiser\"); false applies the network's correction "
-            "as it is.");
+DEFINE_bool(
+    denoise_consistency, evfs::DenoiseRequest().consistency,
+    "--denoise=once: keep the recording's own frames as the solve matched them (the "
+    "part of the denoiser's correction that would change a frame's exposure mean is "
+    "taken out; BENCHMARKS.md \"Residual denoiser\"); false applies the network's correction "
+    "as it is.");
 DEFINE_string(in, "", "denoise: the reconstruction folder (written by evfs reconstruct).");
 DEFINE_double(progress_interval_s, 5.0,
               "While a command runs, a line on stderr (stage, "

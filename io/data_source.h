@@ -1,6 +1,6 @@
 // A recording: events plus intensity frames, read either from a folder in the Event Camera
 // Dataset text layout (events.txt, images.txt, images/, optional exposures.txt) or from an HDF5
-// event file (DESIGN.md §8). Everything downstream reads data through this interface.
+// event file (docs/guide.md). Everything downstream reads data through this interface.
 #ifndef EVFS_IO_DATA_SOURCE_H_
 #define EVFS_IO_DATA_SOURCE_H_
 

@@ -64,7 +64,7 @@ void WriteHdf5(const std::string& path, const EventStream& events,
 bool IsHdf5WrittenByEvfs(const std::string& path);
 
 /// Marks, for its lifetime, the calling thread as running libhdf5 on a file the user gave.
-/// libhdf5 1.10 crashes on some corrupt files (README.md, Robustness); a crash signal raised
+/// libhdf5 1.10 crashes on some corrupt files (docs/robustness.md); a crash signal raised
 /// while the crashing thread is marked is the file's fault, anywhere else evfs' own
 /// (app/crash_guard.h). Every stretch of libhdf5 calls that reads a file runs inside one;
 /// writing does not (a crash there is not the input's doing). Nests.

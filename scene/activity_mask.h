@@ -1,4 +1,5 @@
-// Which pixels a scene needs to solve for (DESIGN.md §3, "skipping what a scene does not need").
+// Which pixels a scene needs to solve for (docs/design.md §3, "skipping what a scene does not
+// need").
 #ifndef EVFS_SCENE_ACTIVITY_MASK_H_
 #define EVFS_SCENE_ACTIVITY_MASK_H_
 

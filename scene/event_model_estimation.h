@@ -1,4 +1,4 @@
-// Deriving the event model's α from the data (DESIGN.md §3, "model parameters from the data").
+// Deriving the event model's α from the data (docs/design.md §3, "model parameters from the data").
 //
 // α decides the quality more than any solver choice: tanh(α·Δg) must be able to express the
 // change Δg one event stands for. α is set to `alpha_times_change / Δg`. When the scene has two
@@ -20,7 +20,7 @@ namespace evfs {
 
 struct EventModelEstimationOptions {
   /// α times the intensity change of one event (in g's units): how far into tanh's range one
-  /// event reaches. Chosen by measurement on the shared DAVIS snippets (README, "Defaults").
+  /// event reaches. Chosen by measurement on the shared DAVIS snippets (docs/model.md).
   double alpha_times_change = 1.0;
   /// Log model: change of g per event assumed when the scene cannot tell (one frame only).
   /// 0.2 is a typical DAVIS contrast threshold; with the default b = 0.5 it is also what

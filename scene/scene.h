@@ -1,5 +1,5 @@
 // A reconstruction problem as data: what was observed (frames with their exposure spans, event
-// frames with their latent spans) on one latent timeline (DESIGN.md §1–2). Interpolation,
+// frames with their latent spans) on one latent timeline (docs/design.md §1–2). Interpolation,
 // prediction and deblurring are presets of this one structure; the solver never branches on
 // the case.
 #ifndef EVFS_SCENE_SCENE_H_
@@ -171,8 +171,8 @@ Scene MakePredictionScene(const TimedFrame& first, int64_t window_end_ns, const 
 Scene MakeDeblurScene(const TimedFrame& blurred, const EventStream& events,
                       const BinningOptions& binning);
 
-/// The initialisation of DESIGN.md §1: the frame observations blended linearly along the latent
-/// timeline (a copy when there is only one, held constant beyond the first and last).
+/// The initialisation of docs/design.md §1: the frame observations blended linearly along the
+/// latent timeline (a copy when there is only one, held constant beyond the first and last).
 Video InitializeLatentVideo(const Scene& scene);
 
 }  // namespace evfs

@@ -2,7 +2,7 @@
 # Runs `evfs video` over N MPI ranks on this machine: rank 0 hands out the windows and writes
 # the output, the other ranks solve them (app/video_mpi.h). Every argument after N goes to evfs.
 #   scripts/evfs-video-mpi.sh 4 --data=DIR --out=OUT --fps=240
-# On a cluster, use srun instead (README.md, `evfs video`). The output is the same as with
+# On a cluster, use srun instead (docs/guide.md, `evfs video`). The output is the same as with
 # one process.
 set -eu
 if [ "$#" -lt 2 ]; then

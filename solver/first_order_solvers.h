@@ -1,5 +1,6 @@
-// Reference solvers on the objective of DESIGN.md §1, driven by the fused evaluation of
-// solver/fused_objective.h (DESIGN.md §3: "so that every speed-up we claim for Ceres is real"):
+// Reference solvers on the objective of docs/design.md §1, driven by the fused evaluation of
+// solver/fused_objective.h (docs/design.md §3: "so that every speed-up we claim for Ceres is
+// real"):
 //
 //  * Adam (Kingma & Ba 2015), the paper's optimiser and schedule: learning rate 0.002 divided by
 //    5 every 200 iterations, β = (0.9, 0.99), 1000 iterations, H clipped to [0, 1] after every

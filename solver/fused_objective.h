@@ -1,6 +1,6 @@
-// The objective of DESIGN.md §1 and its gradient in one fused, multi-threaded pass over a latent
-// video: the reference evaluation for first-order solvers (Adam, L-BFGS), on exactly the terms
-// ProblemBuilder builds as Ceres residual blocks.
+// The objective of docs/design.md §1 and its gradient in one fused, multi-threaded pass over a
+// latent video: the reference evaluation for first-order solvers (Adam, L-BFGS), on exactly the
+// terms ProblemBuilder builds as Ceres residual blocks.
 //
 //   L(H) = w_f  / (hw)   · Σ_j Σ_p ρ(F_j(p) − mean(H_{a_j}(p) … H_{b_j}(p)))        (Eq. 3)
 //        + λ_e  / (hw)   · Σ_k Σ_p ρ(E_k(p) − Σ_{s=a_k}^{b_k−1} c tanh(α Δg_s / c))  (Eqs. 1–2)

@@ -1,5 +1,5 @@
 // The unknowns of a reconstruction: which latent voxels H_t(p) are solved for, and which of them
-// share one value (DESIGN.md §3, "skipping what a scene does not need").
+// share one value (docs/design.md §3, "skipping what a scene does not need").
 //
 // Each pixel in the problem has its time series H_0(p) … H_K(p) cut into segments of
 // consecutive latent frames that share one value. An active pixel starts a new segment only at

@@ -1,4 +1,4 @@
-// Which terms the objective of DESIGN.md §1 has for a scene, and their weights: the one
+// Which terms the objective of docs/design.md §1 has for a scene, and their weights: the one
 // definition that ProblemBuilder (Ceres residual blocks) and FusedObjective (Adam, L-BFGS) both
 // follow.
 //

@@ -1,4 +1,4 @@
-// Scene + options → ceres::Problem over a latent video (DESIGN.md §1, §3).
+// Scene + options → ceres::Problem over a latent video (docs/design.md §1, §3).
 #ifndef EVFS_SOLVER_PROBLEM_BUILDER_H_
 #define EVFS_SOLVER_PROBLEM_BUILDER_H_
 

@@ -1,5 +1,5 @@
-// Everything that shapes a reconstruction: the objective (DESIGN.md §1), its initialisation and
-// the Ceres solver settings.
+// Everything that shapes a reconstruction: the objective (docs/design.md §1), its initialisation
+// and the Ceres solver settings.
 #ifndef EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
 #define EVFS_SOLVER_RECONSTRUCTION_OPTIONS_H_
 
@@ -35,7 +35,7 @@ struct ObjectiveOptions {
   double frame_weight = 4.0;
   /// λ_e: weight of the event term (paper Eq. 2), per event frame. With λ_t, below, weak
   /// enough that the frames and the spatial TV hold what the events do not say, strong enough
-  /// for prediction (sweep: README, "The model and its defaults", and BENCHMARKS.md).
+  /// for prediction (sweep: BENCHMARKS.md, "Where the defaults come from").
   double event_weight = 0.3;
   /// λ_xy: weight of spatial total variation (paper Eq. 4), mean over latent frames.
   double spatial_tv_weight = 2.0;
@@ -44,7 +44,7 @@ struct ObjectiveOptions {
   /// g and α of the event model: by default the log model g(x) = log(x + 0.5), which matches
   /// the log-intensity events of a sensor, with α derived from the data (α <= 0,
   /// EstimateEventModel); b = 0.5 keeps DAVIS frames, whose response is nearly linear, well
-  /// fitted (sweep: README and BENCHMARKS.md).
+  /// fitted (sweep: BENCHMARKS.md).
   EventModelParams event_model = DefaultEventModel();
   /// Form of the spatial TV.
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
@@ -99,8 +99,8 @@ struct ReconstructionOptions {
 
   /// With merged quiet steps, an active pixel that never fires but whose neighbours do after
   /// the last frame gets one change, at the median of their events (LatentLayout), instead of
-  /// staying one constant that nothing after the last frame pins. Measured: README, "The model
-  /// and its defaults".
+  /// staying one constant that nothing after the last frame pins. Measured: BENCHMARKS.md,
+  /// "Unfired pixels after the last frame".
   bool unfired_pixel_changes = true;
 
   /// Solve separately, on solver.num_threads threads, the parts of the scene that no term

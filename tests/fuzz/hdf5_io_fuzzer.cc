@@ -58,9 +58,9 @@ extern "C" const char* __asan_default_options() {
   return "allocator_may_return_null=1:max_allocation_size_mb=2048";
 }
 
-// Upstream bugs of libhdf5 1.10.8 (Debian 12) on corrupt files, listed in README.md, are not
-// evfs's to fix: it leaks a few hundred bytes on some corrupt object headers, and reads past its
-// own buffers decoding some corrupt attribute messages. AddressSanitizer sees libhdf5 (not
+// Upstream bugs of libhdf5 1.10.8 (Debian 12) on corrupt files, listed in docs/robustness.md, are
+// not evfs's to fix: it leaks a few hundred bytes on some corrupt object headers, and reads past
+// its own buffers decoding some corrupt attribute messages. AddressSanitizer sees libhdf5 (not
 // instrumented) only through the functions it calls (memcpy, ...), so those reports are
 // suppressed for libhdf5 alone; a crash inside it still stops the run. Identifiers the reader
 // leaves open are caught by the check in LLVMFuzzerTestOneInput instead of by leak reports.
