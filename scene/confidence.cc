@@ -33,6 +33,55 @@ std::vector<float> BoxMean(const std::vector<float>& values, int rows, int cols,
   return mean;
 }
 
+// The frames' temporal noise, measured where the scene holds still: between two sharp frames,
+// a pixel none of whose 3×3 neighbours fired an event saw no change above a threshold, so the
+// difference of its two frames is mostly their noise (variance 2σ²). The estimate is the robust
+// one, 1.4826 · median |d − median d| / √2 over every such pixel d = F_b − F_a of every pair.
+// Unlike a single frame's estimate it does not read texture or fixed-pattern noise, which the
+// reconstruction carries from the frames and the truth shares. −1 when the scene has no pair of
+// sharp frames or fewer than kMinStillPixels still pixels.
+double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float>& counts,
+                     size_t pixels, int rows, int cols) {
+  constexpr size_t kMinStillPixels = 500;
+  std::vector<float> differences;
+  for (size_t i = 0; i + 1 < anchors.size(); ++i) {
+    const Anchor& first = anchors[i];
+    const Anchor& second = anchors[i + 1];
+    if (!first.sharp || !second.sharp || second.latent <= first.latent) continue;
+    std::vector<uint8_t> fired(pixels, 0);
+    for (size_t p = 0; p < pixels; ++p) {
+      fired[p] = counts[static_cast<size_t>(second.latent) * pixels + p] !=
+                 counts[static_cast<size_t>(first.latent) * pixels + p];
+    }
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        bool still = true;
+        for (int dr = -1; dr <= 1 && still; ++dr) {
+          for (int dc = -1; dc <= 1 && still; ++dc) {
+            const int rr = r + dr, cc = c + dc;
+            if (rr < 0 || rr >= rows || cc < 0 || cc >= cols) continue;
+            still = !fired[static_cast<size_t>(rr) * cols + cc];
+          }
+        }
+        if (!still) continue;
+        const size_t p = static_cast<size_t>(r) * cols + c;
+        differences.push_back(second.image->data()[p] - first.image->data()[p]);
+      }
+    }
+  }
+  if (differences.size() < kMinStillPixels) return -1.0;
+  // The median absolute deviation from the median difference: a change of exposure or gain
+  // between the frames shifts every difference alike and is not noise.
+  const auto median = [](std::vector<float>* values) {
+    auto middle = values->begin() + values->size() / 2;
+    std::nth_element(values->begin(), middle, values->end());
+    return static_cast<double>(*middle);
+  };
+  const double shift = median(&differences);
+  for (float& difference : differences) difference = std::abs(difference - shift);
+  return 1.4826 * median(&differences) / std::sqrt(2.0);
+}
+
 }  // namespace
 
 bool ConfidenceOptions::IsValid(std::string* error) const {
@@ -44,6 +93,8 @@ bool ConfidenceOptions::IsValid(std::string* error) const {
              "off_change_ratio must be positive")
       .Check(std::isfinite(log_offset) && log_offset > 0.0, "log_offset must be positive")
       .Check(std::isfinite(prior_event_variance), "prior_event_variance must be finite")
+      .Check(std::isfinite(threshold_spread) && threshold_spread > 0.0,
+             "threshold_spread must be positive")
       .InRange("pool_radius_px", pool_radius_px, 0, 1000);
   return check.Passed(error);
 }
@@ -101,6 +152,14 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
   if (!anchors.empty()) noise /= static_cast<double>(anchors.size());
   std::stable_sort(anchors.begin(), anchors.end(),
                    [](const Anchor& a, const Anchor& b) { return a.latent < b.latent; });
+  bool noise_measured = false;
+  // Both estimates bound the noise from above: a single frame's reads its texture too, the still
+  // pixels' difference the change under one threshold that fired no event. The smaller is kept.
+  const double temporal = TemporalNoise(anchors, n, pixels, rows, cols);
+  if (temporal >= 0.0 && temporal < noise) {
+    noise = temporal;
+    noise_measured = true;
+  }
 
   // The gap D between each pair of neighbouring sharp frames, pooled locally.
   const double b = options.log_offset;
@@ -123,6 +182,13 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
   }
   const double measured = sum_events > 0.0 ? sum_gap2 / sum_events : -1.0;
   const double per_event = measured >= 0.0 ? measured : options.prior_event_variance;
+
+  // Pixels where the scene moved over the window: they or a neighbour fired an event.
+  std::vector<float> fired(pixels);
+  for (size_t p = 0; p < pixels; ++p) {
+    fired[p] = at(n, frames - 1, p) > 0.0 ? 1.0f : 0.0f;
+  }
+  const std::vector<float> moved = BoxMean(fired, rows, cols, 1);
 
   Video sigma(rows, cols, frames);
   for (int t = 0; t < frames; ++t) {
@@ -152,9 +218,15 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
                                                ? anchors[before].latent
                                                : anchors[after].latent);
         const double events = std::abs(at(n, t, p) - at(n, nearest, p));
-        const double one_event = (std::max(estimate[p], 0.0) + b) * on;
+        const double one_event = (std::max(estimate[p], 0.0) + b) * options.threshold_spread;
         const double v = per_event >= 0.0 ? per_event : one_event * one_event;
-        variance = v * events + 2.0 * noise * noise;
+        // What the events have not recorded: away from the observation, where the scene moved,
+        // the change since the pixel's last crossing, under one threshold and taken as uniform
+        // over it (variance C² / 12 in g).
+        const double threshold = (std::max(estimate[p], 0.0) + b) * on;
+        const double residual =
+            t != nearest && moved[p] > 0.0f ? threshold * threshold / 12.0 : 0.0;
+        variance = v * events + residual + 2.0 * noise * noise;
       }
       out[p] = std::sqrt(variance);
     }
@@ -162,18 +234,22 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
   if (model != nullptr) {
     model->frame_noise_sigma = noise;
     model->measured_event_variance = measured;
-    char line[200];
+    const char* noise_source =
+        noise_measured ? "measured where the scene holds still" : "single-frame estimate";
+    char line[240];
     if (measured >= 0.0) {
       std::snprintf(line, sizeof(line),
-                    "frame noise %.4f; one event's error %.4f (measured between the sharp frames)",
-                    noise, std::sqrt(measured));
+                    "frame noise %.4f (%s); one event's error %.4f (measured between the sharp "
+                    "frames)",
+                    noise, noise_source, std::sqrt(measured));
     } else if (options.prior_event_variance >= 0.0) {
-      std::snprintf(line, sizeof(line), "frame noise %.4f; one event's error %.4f (prior)", noise,
-                    std::sqrt(options.prior_event_variance));
+      std::snprintf(line, sizeof(line), "frame noise %.4f (%s); one event's error %.4f (prior)",
+                    noise, noise_source, std::sqrt(options.prior_event_variance));
     } else {
       std::snprintf(line, sizeof(line),
-                    "frame noise %.4f; one event's error: its own change (nothing measured it)",
-                    noise);
+                    "frame noise %.4f (%s); one event's error (I + b) x %.3f (the threshold's "
+                    "spread: nothing measured it)",
+                    noise, noise_source, options.threshold_spread);
     }
     model->description = line;
   }

@@ -11,8 +11,9 @@
 //  * Beyond the last sharp frame (prediction) or inside a blurred exposure nothing pins the far
 //    end: the variance grows with the events since the nearest observation, n · v, v the
 //    per-event variance the scene's pairs of sharp frames measured (Σ D² / Σ (n + 1)), or the
-//    caller's prior, or one event's own change ((I + b) · Δg)² when nothing measured it.
-//  * The frames' own noise (NoiseSigma): once for the frame the output is compared with and
+//    caller's prior, or the threshold's spread ((I + b) · σ_C)² when nothing measured it.
+//  * The frames' own noise, measured where the scene holds still between two sharp frames, else
+//    NoiseSigma's single-frame estimate: once for the frame the output is compared with and
 //    once for the observations the output carries (their blend at s).
 #ifndef EVFS_SCENE_CONFIDENCE_H_
 #define EVFS_SCENE_CONFIDENCE_H_
@@ -34,6 +35,10 @@ struct ConfidenceOptions {
   /// Variance (intensity², per event) of what one event gets wrong, for scenes without a pair
   /// of sharp frames to measure it; < 0: unknown (one event's own change is used).
   double prior_event_variance = -1.0;
+  /// Spread of a pixel's contrast threshold in g (σ of the change one event stands for), > 0:
+  /// what one event gets wrong when nothing in the scene measured it. 0.03 is the literature's
+  /// threshold mismatch (v2e's default; DAVIS pixels measure 2–4 % contrast).
+  double threshold_spread = 0.03;
   /// Half-width in pixels of the square over which the frames' gaps are pooled, >= 0.
   int pool_radius_px = 2;
 

@@ -66,8 +66,10 @@ TEST(Confidence, BridgeBetweenSharpFramesGrowsWithTheFramesGap) {
   }
 }
 
-// After a single frame nothing measures the events: each one may be wrong by its own change,
-// ((I + b) · Δg), and the errors add as a random walk; a prior per-event variance replaces it.
+// After a single frame nothing measures the events: each one may be wrong by the threshold's
+// spread, ((I + b) · σ_C), and the errors add as a random walk; a prior per-event variance
+// replaces it. Away from the frame, where the scene moved, the change not yet recorded adds
+// ((I + b) · Δg)² / 12.
 TEST(Confidence, PredictionGrowsWithTheEventsSinceTheFrame) {
   const Scene scene =
       MakePredictionScene(Flat(0.3, 0), kWindowNs, TwoOnEventsEverywhere(), BinningOptions());
@@ -76,11 +78,53 @@ TEST(Confidence, PredictionGrowsWithTheEventsSinceTheFrame) {
   const Video sigma = PredictErrorSigma(scene, Constant(scene, 0.3), options, &model);
   EXPECT_LT(model.measured_event_variance, 0.0);
   const int last = sigma.num_frames() - 1;
+  const double unrecorded = 0.8 * 0.2 * 0.8 * 0.2 / 12.0;
   EXPECT_NEAR(sigma.at(0, 2, 2), 0.0, kTolerance);
-  EXPECT_NEAR(sigma.at(last, 2, 2), std::sqrt(2.0) * 0.8 * 0.2, kTolerance);
+  EXPECT_NEAR(sigma.at(last, 2, 2), std::sqrt(2.0 * 0.8 * 0.03 * 0.8 * 0.03 + unrecorded),
+              kTolerance);
   options.prior_event_variance = 0.01;
   EXPECT_NEAR(PredictErrorSigma(scene, Constant(scene, 0.3), options).at(last, 2, 2),
-              std::sqrt(2 * 0.01), kTolerance);
+              std::sqrt(2 * 0.01 + unrecorded), kTolerance);
+}
+
+// Where no pixel of a 3x3 neighbourhood fired between two sharp frames, their difference is
+// their noise: the model measures it there (robustly, around the median difference, so that a
+// change of exposure between the frames does not count), not from one frame's texture.
+TEST(Confidence, FrameNoiseIsMeasuredWhereTheSceneHoldsStill) {
+  constexpr int kWide = 64;
+  const double sigma_noise = 0.01;
+  TimedFrame first, second;
+  first.image = Image::Constant(kWide, kWide, 0.4);
+  second.image = Image::Constant(kWide, kWide, 0.45);  // a brighter exposure, not noise
+  uint64_t state = 12345;
+  const auto gaussian = [&state]() {
+    // Box–Muller on a linear congruential generator: reproducible without <random>'s
+    // implementation-defined distributions.
+    const auto uniform = [&state]() {
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+      return (static_cast<double>(state >> 11) + 0.5) / 9007199254740992.0;
+    };
+    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(6.283185307179586 * uniform());
+  };
+  for (int y = 0; y < kWide; ++y) {
+    for (int x = 0; x < kWide; ++x) {
+      // Texture both frames share (a fixed pattern) and the frames' own temporal noise.
+      const double texture = ((x / 4 + y / 4) % 2) * 0.2;
+      first.image(y, x) += texture + sigma_noise * gaussian();
+      second.image(y, x) += texture + sigma_noise * gaussian();
+    }
+  }
+  first.exposure_begin_ns = first.exposure_end_ns = 0;
+  second.exposure_begin_ns = second.exposure_end_ns = kWindowNs;
+  first.label = second.label = "noisy";
+  EventStream events(kWide, kWide);
+  events.push_back(kWindowNs / 2, 10, 10, 1);  // one event: the still pixels are the others
+  const Scene scene = MakeInterpolationScene(first, second, events, BinningOptions());
+  ConfidenceModel model;
+  PredictErrorSigma(scene, Constant(scene, 0.5), ConfidenceOptions(), &model);
+  EXPECT_NEAR(model.frame_noise_sigma, sigma_noise, 0.1 * sigma_noise);
+  EXPECT_NE(model.description.find("measured where the scene holds still"), std::string::npos)
+      << model.description;
 }
 
 TEST(Confidence, ShareWithinSigmaCountsThePixelsInsideTheBand) {
