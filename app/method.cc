@@ -65,6 +65,10 @@ void RunCeresLm(const Scene& scene, const MethodOptions& options, const Video& i
   result->video = std::move(reconstruction.video);
   result->solved = summary.solved;
   result->message = summary.solved ? summary.ceres.message : summary.skipped_reason;
+  if (summary.solved && !summary.stopped_early.empty()) {
+    result->message = "stopped early (" + summary.stopped_early + ") after " +
+                      std::to_string(summary.iterations) + " iterations";
+  }
   result->iterations = summary.iterations;
   result->initial_cost = summary.initial_cost;
   result->final_cost = summary.final_cost;
@@ -87,12 +91,14 @@ void RunFirstOrder(const Scene& scene, const MethodOptions& options, const Video
   const ActivityMask mask(scene.events, options.reconstruction.activity_radius_px);
   FirstOrderSummary first_order;
   if (options.method == Method::kCeresLbfgs) {
-    first_order = SolveWithLbfgs(scene, objective, mask, options.lbfgs, &result->video, observer);
+    first_order = SolveWithLbfgs(scene, objective, mask, options.lbfgs, &result->video, observer,
+                                 options.reconstruction.stop);
   } else {
     AdamOptions adam = options.adam;
     adam.penalty = options.method == Method::kAdam ? L1Penalty::kTrueL1 : L1Penalty::kSmoothed;
     adam.bound_intensities = options.reconstruction.bound_intensities;
-    first_order = SolveWithAdam(scene, objective, mask, adam, &result->video, observer);
+    first_order = SolveWithAdam(scene, objective, mask, adam, &result->video, observer,
+                                options.reconstruction.stop);
     result->parameters = {{"learning_rate", adam.learning_rate},
                           {"decay_every", static_cast<double>(adam.decay_every)},
                           {"decay_factor", adam.decay_factor},
@@ -108,6 +114,7 @@ void RunFirstOrder(const Scene& scene, const MethodOptions& options, const Video
   result->build_time_s = first_order.setup_time_s;
   result->solve_time_s = first_order.solve_time_s;
   summary.solved = true;
+  summary.stopped_early = first_order.stopped_early;
   summary.iterations = first_order.iterations;
   summary.initial_cost = first_order.initial_cost;
   summary.final_cost = first_order.final_cost;
@@ -141,9 +148,17 @@ bool MethodSupports(Method method, const Scene& scene, std::string* why_not) {
   return BaselineSupports(AsBaseline(method), scene, why_not);
 }
 
-MethodResult RunMethod(const Scene& scene, const MethodOptions& options,
+void StartSolveClock(MethodOptions* options) {
+  options->reconstruction.stop =
+      StopCondition::After(options->reconstruction.solver.max_solver_time_in_seconds)
+          .WhenRaised(options->interrupt);
+}
+
+MethodResult RunMethod(const Scene& scene, const MethodOptions& given_options,
                        const IterationCallback& progress, bool record_checkpoints,
                        const CheckpointTruth* truth) {
+  MethodOptions options = given_options;
+  if (!options.reconstruction.stop.active()) StartSolveClock(&options);
   MethodResult result;
   result.method = MethodName(options.method);
   if (!IsIterative(options.method)) {

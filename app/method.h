@@ -9,6 +9,7 @@
 #ifndef EVFS_APP_METHOD_H_
 #define EVFS_APP_METHOD_H_
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -75,7 +76,16 @@ struct MethodOptions {
   BaselineOptions baseline;
   /// Where the iterative methods start.
   Initialization initialization = Initialization::kBlend;
+  /// Raised by another thread to end the solve early (Python's Ctrl-C); may be null. It must
+  /// outlive the solve.
+  const std::atomic<bool>* interrupt = nullptr;
 };
+
+/// Starts the clock of one command's (or one video window's) solve: sets
+/// options->reconstruction.stop to end every solve stage that follows — the method, plug & play
+/// — reconstruction.solver.max_solver_time_in_seconds (--max_time_s) from now, or when
+/// options->interrupt is raised.
+void StartSolveClock(MethodOptions* options);
 
 /// One point of an iterative solve: cost, and quality when a truth frame was given.
 struct Checkpoint {

@@ -69,6 +69,7 @@ Video PlugAndPlay(const Scene& scene, const ReconstructionOptions& options,
   x_update.smoothing_continuation.clear();  // a warm start needs no continuation
   double rho = pnp.initial_rho;
   for (int k = 0; k < pnp.iterations; ++k) {
+    if (options.stop.Reached()) break;  // z, the last denoised iterate, is the answer
     auto target = std::make_shared<Video>(z);
     Values(target.get()) -= Values(&u);
     x_update.objective.prior_weight = rho;

@@ -242,7 +242,9 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
                                " cannot reconstruct this case: " + why_not);
   }
   stage(request.progress ? "build" : "build and solve");
-  result.run = RunMethod(scene, request.method, request.progress, request.checkpoints,
+  MethodOptions method = request.method;
+  StartSolveClock(&method);
+  result.run = RunMethod(scene, method, request.progress, request.checkpoints,
                          score ? &checkpoint_truth : nullptr);
   result.time.build_s = result.run.build_time_s;
   result.time.solve_s = result.run.solve_time_s;
@@ -252,8 +254,8 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
     const DenoiseRegion region = SolvedRegion(scene, request.method, result.run.solved);
     const Image* truth = score ? &truth_image : nullptr;
     if (request.denoise.mode == DenoiseMode::kPnp) {
-      result.denoise = PlugAndPlayLatentVideo(*denoiser, scene, request.method, request.denoise.pnp,
-                                              region, truth, truth_latent, &result.run);
+      result.denoise = PlugAndPlayLatentVideo(*denoiser, scene, method, request.denoise.pnp, region,
+                                              truth, truth_latent, &result.run);
     } else {
       result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region,
                                           request.denoise.consistency ? &scene : nullptr, truth,
@@ -430,6 +432,9 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   Json solver;
   solver["name"] = run.method;
   solver["message"] = run.message;
+  if (!run.reconstruction.stopped_early.empty()) {
+    solver["stopped_early"] = run.reconstruction.stopped_early;
+  }
   if (iterative) {
     solver["initialization"] = run.initialization;
     solver["bounds"] = options.bound_intensities;

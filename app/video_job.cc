@@ -310,7 +310,13 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
                                " cannot reconstruct window " + std::to_string(window.index) + ": " +
                                why_not);
   }
-  MethodResult run = RunMethod(scene, context.method, IterationCallback(), false, nullptr);
+  MethodOptions method = context.method;  // --max_time_s bounds each window's solve
+  StartSolveClock(&method);
+  MethodResult run = RunMethod(scene, method, IterationCallback(), false, nullptr);
+  // An interrupted window is not recorded: --resume solves it again.
+  if (method.reconstruction.stop.Interrupted()) {
+    throw InterruptedError("interrupted in window " + std::to_string(window.index));
+  }
   int64_t begin = 0, end = 0;
   context.clock->FramesOf(window, &begin, &end);
   double denoise_s = 0.0;
@@ -684,6 +690,10 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   const auto take = [&]() -> int {
     const std::lock_guard<std::mutex> lock(take_mutex);
     if (failed) return -1;  // an earlier window failed: the run ends with its error
+    if (request.method.interrupt != nullptr && request.method.interrupt->load()) {
+      failed = true;
+      return -1;
+    }
     if (worker) return distribution->next();
     return next_pending < pending.size() ? pending[next_pending++] : -1;
   };
@@ -708,12 +718,19 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
           progress.elapsed_s = SecondsSince(solve_start);
           records[index] = std::move(record);
           if (request.progress) request.progress(progress);
+        } catch (const InterruptedError&) {
+          failed = true;  // the check after the loop reports it
         } catch (...) {
           failed = true;
           throw;
         }
       }
     });
+  }
+  if (request.method.interrupt != nullptr && request.method.interrupt->load()) {
+    // Like a signal, an interrupt keeps the finished windows for --resume.
+    remove_on_error.armed = false;
+    throw InterruptedError("interrupted: the windows finished so far are kept for --resume");
   }
   result.solve_wall_s = SecondsSince(solve_start);
   result.windows_per_s = result.solve_wall_s > 0.0 ? solved / result.solve_wall_s : 0.0;

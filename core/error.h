@@ -41,6 +41,12 @@ class SolverError : public Error {
   explicit SolverError(const std::string& message) : Error(message) {}
 };
 
+/// The caller asked the work to stop (MethodOptions::interrupt): what it had done is discarded.
+class InterruptedError : public Error {
+ public:
+  explicit InterruptedError(const std::string& message) : Error(message) {}
+};
+
 /// A value given by the user (an option, a flag, an index) is outside what is accepted.
 class InvalidArgumentError : public Error {
  public:

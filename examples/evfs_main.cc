@@ -223,7 +223,10 @@ DEFINE_int32(max_iterations, evfs::DefaultSolverOptions().max_num_iterations,
              "Most Levenberg-Marquardt iterations.");
 DEFINE_int32(max_linear_iterations, evfs::DefaultSolverOptions().max_linear_solver_iterations,
              "Most CG iterations per LM step.");
-DEFINE_double(max_time_s, 1e6, "Stop the solve after this many seconds.");
+DEFINE_double(max_time_s, 1e6,
+              "Time budget in seconds of the whole solve of reconstruct (every stage, part, band "
+              "and plug & play iteration together) or of each window of video: the solve ends "
+              "with the answer it has (summary.json solver.stopped_early says so).");
 DEFINE_int32(bounds_line_search_iterations,
              evfs::DefaultSolverOptions().max_num_line_search_step_size_iterations,
              "Steps of Ceres' projected line search after each bounded trust-region step "

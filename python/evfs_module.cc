@@ -2,16 +2,21 @@
 // event simulator run on NumPy arrays, through the same application library as the command
 // line (app/). Errors that are the user's become ValueError with the command line's one-line
 // message, a failed solve RuntimeError. The GIL is released while evfs reads, solves and
-// simulates.
+// simulates; reconstruct and video stop within an iteration at Ctrl-C (KeyboardInterrupt).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <future>
 #include <limits>
 #include <memory>
 #include <string>
+#include <system_error>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -24,6 +29,7 @@
 #include "core/video.h"
 #include "events/simulator.h"
 #include "io/data_source.h"
+#include "io/image_io.h"
 #include "io/output_target.h"
 #include "python/array_source.h"
 #include "python/reconstruct_options.h"
@@ -35,6 +41,8 @@ namespace py = pybind11;
 
 // How summaries and messages name a recording given as arrays.
 constexpr char kArraysLabel[] = "the frames array";
+// The widest and highest frame: event coordinates are uint16.
+constexpr py::ssize_t kMaxSensorSide = 65536;
 
 std::string TypeName(py::handle object) {
   return py::str(py::type::handle_of(object).attr("__name__"));
@@ -64,7 +72,59 @@ py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
     throw InvalidArgumentError(name + " must be a " + expected + " array, not " +
                                std::to_string(array.ndim()) + "-D");
   }
-  return py::array_t<T, py::array::c_style>::ensure(array);
+  // A strided or broadcast view is copied; a copy that cannot be allocated raises MemoryError
+  // rather than handing on a null array.
+  auto contiguous = py::array_t<T, py::array::c_style>::ensure(array);
+  if (!contiguous) throw py::error_already_set();
+  return contiguous;
+}
+
+// Runs `work` on a thread of its own, without the GIL, while the interpreter's thread waits and
+// runs Python's signal handlers every kSignalPollInterval: when one raises (Ctrl-C's
+// KeyboardInterrupt), `interrupt` asks the work to stop at its next iteration, and once it has,
+// that exception propagates and whatever the work did is discarded. Only the main thread runs
+// signal handlers; called from another, this only waits.
+template <typename Work>
+void RunInterruptible(std::atomic<bool>* interrupt, Work&& work) {
+  constexpr auto kSignalPollInterval = std::chrono::milliseconds(50);
+  std::promise<void> finished;
+  std::future<void> done = finished.get_future();
+  std::thread worker;
+  try {
+    worker = std::thread([&work, &finished] {
+      try {
+        work();
+        finished.set_value();
+      } catch (...) {
+        finished.set_exception(std::current_exception());
+      }
+    });
+  } catch (const std::system_error&) {
+    // No thread to spare: run it here, without the GIL, and without Ctrl-C until it ends.
+    py::gil_scoped_release release;
+    work();
+    return;
+  }
+  bool interrupted = false;
+  for (;;) {
+    std::future_status status;
+    {
+      py::gil_scoped_release release;
+      status = done.wait_for(kSignalPollInterval);
+    }
+    if (status == std::future_status::ready) break;
+    if (PyErr_CheckSignals() != 0) {
+      interrupted = true;
+      interrupt->store(true);
+      break;
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    worker.join();
+  }
+  if (interrupted) throw py::error_already_set();
+  done.get();  // rethrows the work's exception
 }
 
 // Inputs of reconstruct and simulate, kept alive (and referenced by `recording`) for the call.
@@ -83,6 +143,14 @@ void SetFrames(py::handle frames_object, RecordingInput* input) {
                                TypeName(frames_object));
   }
   const py::array frames = py::reinterpret_borrow<py::array>(frames_object);
+  // The size is bounded before anything is copied or allocated for it, as the readers bound a
+  // declared sensor: a broadcast view of a few bytes may claim gigabytes.
+  if (frames.ndim() == 3 && (frames.shape(1) > kMaxSensorSide || frames.shape(2) > kMaxSensorSide ||
+                             frames.shape(1) * frames.shape(2) > kMaxSensorPixels)) {
+    throw InvalidArgumentError("frames are " + std::to_string(frames.shape(2)) + "x" +
+                               std::to_string(frames.shape(1)) + ": more than the " +
+                               std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
+  }
   RecordingArrays& recording = input->recording;
   if (frames.dtype().is(py::dtype::of<float>())) {
     const auto checked = CheckedArray<float>(frames, 3, "frames");
@@ -298,13 +366,14 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   SetEvents(events, &input);
   ReconstructResult result;
   std::string summary;
-  {
-    py::gil_scoped_release release;
+  std::atomic<bool> interrupt(false);
+  request.method.interrupt = &interrupt;
+  RunInterruptible(&interrupt, [&] {
     CheckRecordingArrays(input.recording, "frames", "events");
     const ArraySource source(input.recording, kArraysLabel);
     result = RunReconstruction(request, source);
     summary = SummaryJson(request, result);
-  }
+  });
   py::dict output;
   output["times"] = Seconds(result.output.timestamps_ns());
   output["frames"] = VideoArray(std::move(result.output), dtype);
@@ -379,14 +448,15 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   output.inputs = {data};
   VideoResult result;
   std::string path;
-  {
-    py::gil_scoped_release release;
+  std::atomic<bool> interrupt(false);
+  request.method.interrupt = &interrupt;
+  RunInterruptible(&interrupt, [&] {
     OutputTarget target(output);
     result = RunVideo(request, target.path(), target.staging());
     target.Commit();
     RemoveVideoWorkFolder(target.path());
     path = target.path();
-  }
+  });
   py::dict summary;
   summary["path"] = path;
   summary["windows"] = result.windows;

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/option_checker.h"
 #include "core/time.h"
+#include "solver/stop_callback.h"
 
 namespace evfs {
 namespace {
@@ -171,7 +172,7 @@ bool LbfgsOptions::IsValid(std::string* error) const {
 
 FirstOrderSummary SolveWithAdam(const Scene& scene, const ObjectiveOptions& objective_options,
                                 const ActivityMask& mask, const AdamOptions& options, Video* latent,
-                                const IterationCallback& callback) {
+                                const IterationCallback& callback, const StopCondition& stop) {
   const Clock::time_point setup_start = Clock::now();
   const std::unique_ptr<FusedObjective> fused =
       PrepareObjective("adam", options, options.penalty, scene, objective_options, mask, *latent);
@@ -238,6 +239,13 @@ FirstOrderSummary SolveWithAdam(const Scene& scene, const ObjectiveOptions& obje
       summary.termination = "no active pixels: nothing to solve";
       break;
     }
+    if (!last && stop.Reached()) {
+      summary.termination = std::string("stopped early (") + stop.Reason() + ") after " +
+                            std::to_string(iteration) + " of " +
+                            std::to_string(options.max_iterations) + " iterations";
+      summary.stopped_early = stop.Reason();
+      break;
+    }
     if (last) {
       summary.termination = "reached " + std::to_string(iteration) + " iterations";
       // The schedule returns its last iterate, as the paper does; say so when that is worse.
@@ -253,7 +261,8 @@ FirstOrderSummary SolveWithAdam(const Scene& scene, const ObjectiveOptions& obje
 
 FirstOrderSummary SolveWithLbfgs(const Scene& scene, const ObjectiveOptions& objective_options,
                                  const ActivityMask& mask, const LbfgsOptions& options,
-                                 Video* latent, const IterationCallback& callback) {
+                                 Video* latent, const IterationCallback& callback,
+                                 const StopCondition& stop) {
   const Clock::time_point setup_start = Clock::now();
   const std::unique_ptr<FusedObjective> fused = PrepareObjective(
       "lbfgs", options, L1Penalty::kSmoothed, scene, objective_options, mask, *latent);
@@ -282,6 +291,12 @@ FirstOrderSummary SolveWithLbfgs(const Scene& scene, const ObjectiveOptions& obj
     solver_options.update_state_every_iteration = true;
     solver_options.callbacks.push_back(&iteration_callback);
   }
+  StopCallback stop_callback(stop);
+  if (stop.active()) {
+    solver_options.max_solver_time_in_seconds =
+        std::min(solver_options.max_solver_time_in_seconds, stop.SecondsLeft());
+    solver_options.callbacks.push_back(&stop_callback);
+  }
   ceres::GradientProblemSolver::Summary ceres_summary;
   ceres::Solve(solver_options, problem, parameters.data(), &ceres_summary);
   objective.ScatterActive(parameters.data(), latent->data());
@@ -291,6 +306,11 @@ FirstOrderSummary SolveWithLbfgs(const Scene& scene, const ObjectiveOptions& obj
   summary.final_cost = ceres_summary.final_cost;
   summary.termination = ceres::TerminationTypeToString(ceres_summary.termination_type) +
                         std::string(": ") + ceres_summary.message;
+  if (stop.Reached()) {
+    summary.stopped_early = stop.Reason();
+    summary.termination = std::string("stopped early (") + stop.Reason() + ") after " +
+                          std::to_string(summary.iterations) + " iterations";
+  }
   summary.solve_time_s = clock.elapsed_s();
   return summary;
 }

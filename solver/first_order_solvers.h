@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/stop_condition.h"
 #include "core/video.h"
 #include "scene/activity_mask.h"
 #include "scene/scene.h"
@@ -95,23 +96,28 @@ struct FirstOrderSummary {
   double solve_time_s = 0.0;
   /// Why the solve stopped, in words.
   std::string termination;
+  /// Why a StopCondition ended it before its own end (StopCondition::Reason); empty otherwise.
+  std::string stopped_early;
   /// Unknowns: active pixels × latent frames.
   int64_t active_voxels = 0;
 };
 
 /// Minimises the objective over the active voxels of `latent` (initialised by the caller,
 /// scene-sized) with Adam. `callback`, when given, sees every iterate (all voxels, ring and
-/// inactive ones at their fixed values) with its cost; without it nothing is spent on it. Throws
+/// inactive ones at their fixed values) with its cost; without it nothing is spent on it. The
+/// solve ends at the first iteration where `stop` is reached, with the iterate it has. Throws
 /// InvalidArgumentError for invalid options, an α that is not > 0, or a latent video or mask of
 /// another size.
 FirstOrderSummary SolveWithAdam(const Scene& scene, const ObjectiveOptions& objective,
                                 const ActivityMask& mask, const AdamOptions& options, Video* latent,
-                                const IterationCallback& callback = nullptr);
+                                const IterationCallback& callback = nullptr,
+                                const StopCondition& stop = StopCondition());
 
 /// The same with Ceres' L-BFGS on the smoothed objective (unbounded, see LbfgsOptions).
 FirstOrderSummary SolveWithLbfgs(const Scene& scene, const ObjectiveOptions& objective,
                                  const ActivityMask& mask, const LbfgsOptions& options,
-                                 Video* latent, const IterationCallback& callback = nullptr);
+                                 Video* latent, const IterationCallback& callback = nullptr,
+                                 const StopCondition& stop = StopCondition());
 
 }  // namespace evfs
 

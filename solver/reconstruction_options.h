@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/enum_names.h"
+#include "core/stop_condition.h"
 #include "core/video.h"
 #include "cost_functions/spatial_tv_residual.h"
 #include "scene/event_model.h"
@@ -159,6 +160,11 @@ struct ReconstructionOptions {
   /// Ceres settings, all of them available to library users; the defaults below are set by
   /// DefaultSolverOptions() (Levenberg–Marquardt, CGNR with a Jacobi preconditioner).
   ceres::Solver::Options solver;
+
+  /// Ends the whole solve early — every continuation stage, batch, band and part together — at a
+  /// deadline or an interrupt (core/stop_condition.h); each Ceres solve also keeps its own
+  /// solver.max_solver_time_in_seconds. Default: never.
+  StopCondition stop;
 
   ReconstructionOptions();
   bool IsValid(std::string* error) const;

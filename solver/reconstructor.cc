@@ -12,6 +12,7 @@
 #include "core/parallel.h"
 #include "core/time.h"
 #include "solver/step_ramps.h"
+#include "solver/stop_callback.h"
 
 namespace evfs {
 namespace {
@@ -194,8 +195,11 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   int iterations = 0;      // of the unit that took most
   bool first_unit = true;
   bool any_unknowns = false;
+  const StopCondition& stop = solve_options.stop;
+  StopCallback stop_callback(stop);
   for (const std::vector<ProblemUnit>& batch : plan.batches()) {
     if (adapter && adapter->stopped()) break;
+    if (stop.Reached()) break;  // the batches not reached keep their start
     const auto batch_build_start = Clock::now();
     std::vector<std::unique_ptr<BuiltProblem>> parts(batch.size());
     ParallelForEach(static_cast<int>(batch.size()), threads,
@@ -223,6 +227,11 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
     const auto part_options = [&](size_t i, int part_threads) {
       ceres::Solver::Options part = solve_options.solver;
       part.num_threads = part_threads;
+      if (stop.active()) {
+        part.max_solver_time_in_seconds =
+            std::min(part.max_solver_time_in_seconds, stop.SecondsLeft());
+        part.callbacks.push_back(&stop_callback);
+      }
       if (parts.size() > 1 && costs[i] > 0.0) part.function_tolerance *= batch_cost / costs[i];
       return part;
     };
@@ -255,9 +264,17 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
       // split what remains.
       const int workers = std::min<int>(threads, static_cast<int>(parts.size()));
       ParallelForEach(static_cast<int>(parts.size()), workers, [&](int i) {
+        if (stop.Reached()) return;  // left at its start, below
         ceres::Solve(part_options(i, std::max(1, threads / workers)), &parts[i]->problem(),
                      &part_summaries[i]);
       });
+      for (size_t i = 0; i < parts.size(); ++i) {
+        if (!part_summaries[i].iterations.empty()) continue;
+        const double cost = InitialCost(&parts[i]->problem());
+        part_summaries[i].termination_type = ceres::USER_SUCCESS;
+        part_summaries[i].message = "not solved: stopped early";
+        part_summaries[i].initial_cost = part_summaries[i].final_cost = cost;
+      }
     }
     summary.solve_time_s += SecondsSince(solve_start) - time_in_callback_s;
     for (size_t i = 0; i < parts.size(); ++i) {
@@ -266,11 +283,19 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
       iterations = std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
     }
   }
+  if (stop.Reached()) summary.stopped_early = stop.Reason();
+  if (!summary.stopped_early.empty() && summary.ceres.iterations.empty()) {
+    // Stopped before any part was solved: nothing failed.
+    summary.ceres.termination_type = ceres::USER_SUCCESS;
+    summary.ceres.message = std::string("stopped early: ") + summary.stopped_early;
+  }
   // Bands overlap: a pixel is counted once.
   summary.problem.active_pixels = plan.active_pixels();
   summary.problem.skipped_pixels -= summary.problem.active_pixels;
   if (!any_unknowns) {
-    summary.skipped_reason = "no unknowns: no pixel is active";
+    summary.skipped_reason = summary.stopped_early.empty()
+                                 ? "no unknowns: no pixel is active"
+                                 : "stopped early before the solve: " + summary.stopped_early;
     return;
   }
   summary.iterations += iterations;
@@ -319,7 +344,7 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     // answer is the minimiser it asked for.
     if (i + 1 < scales.size() || options.objective.prior_weight != 0.0) stage.step_ramp_px = 0.0;
     BuildAndSolve(scene, stage, callback, &result);
-    if (!summary.solved) break;  // nothing to solve
+    if (!summary.solved || !summary.stopped_early.empty()) break;
   }
   // With a prior (plug & play's x-update) the solve's answer is the minimiser it asked for.
   if (options.quiet_blend_fraction > 0.0 && options.objective.prior_weight == 0.0 &&

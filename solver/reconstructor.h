@@ -25,6 +25,9 @@ struct ReconstructionSummary {
   bool alpha_derived = false;
   bool solved = false;         // false when the scene needed no solve
   std::string skipped_reason;  // why not, when solved is false
+  /// Why options.stop ended the solve before its own end (StopCondition::Reason); the parts and
+  /// bands not reached keep their start. Empty otherwise.
+  std::string stopped_early;
   double build_time_s = 0.0;
   double solve_time_s = 0.0;
   double initial_cost = 0.0;

@@ -529,3 +529,68 @@ def test_video_identical_to_cli(demo, tmp_path):
     with pytest.raises(ValueError):
         evfs.video(data, str(foreign), fps=400, overwrite=True)
     assert (foreign / "keep.txt").read_text() == "user data"
+
+
+# ---------------------------------------------------------------------------------------------
+# What may not kill the interpreter, and Ctrl-C
+
+
+def test_broadcast_and_strided_views_are_bounded_before_any_copy(small):
+    times = np.array([0.0, 0.04])
+    events = {"t": np.array([0.01]), "x": np.array([1], np.uint16), "y": np.array([1], np.uint16),
+              "p": np.array([1], np.int8)}
+    # A zero-stride view of 8 bytes that claims 6.4 GB: refused from its shape, nothing copied.
+    huge = np.broadcast_to(0.5, (2, 20000, 20000))
+    with pytest.raises(ValueError, match=r"20000x20000: more than the 67108864 pixels"):
+        evfs.reconstruct(huge, times, events)
+    with pytest.raises(ValueError, match="more than the 67108864 pixels"):
+        evfs.simulate(np.broadcast_to(np.float32(0.5), (2, 1, 70000)), times)
+    # A small broadcast or reversed view is copied and reconstructs as its contiguous copy does.
+    view = np.broadcast_to(small["frames"][:1], small["frames"].shape)[:, ::-1, :]
+    copy = np.ascontiguousarray(view)
+    a = reconstruct(small, frames=view, options={"solver": "copy"})
+    b = reconstruct(small, frames=copy, options={"solver": "copy"})
+    np.testing.assert_array_equal(a["frames"], b["frames"])
+
+
+def interrupt_after(seconds):
+    """SIGINT to this process after `seconds`, as Ctrl-C sends it; returns the timer."""
+    import signal
+
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_reconstruct_within_a_second(small):
+    # A solve of minutes: Adam for a million steps.
+    options = {"solver": "adam", "adam_iterations": 1000000, "threads": 1}
+    timer = interrupt_after(0.5)
+    begin = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            reconstruct(small, options=options)
+    finally:
+        timer.cancel()
+    elapsed = time.perf_counter() - begin
+    assert elapsed < 0.5 + 1.0, f"KeyboardInterrupt came {elapsed - 0.5:.2f} s after the signal"
+    # The module is usable afterwards.
+    assert reconstruct(small, options={"solver": "copy"})["frames"].shape[1:] == \
+        small["frames"].shape[1:]
+
+
+def test_ctrl_c_stops_video_and_leaves_no_output(demo, tmp_path):
+    out = tmp_path / "video"
+    options = {"solver": "adam", "adam_iterations": 1000000}
+    timer = interrupt_after(0.5)
+    begin = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            evfs.video(str(demo / "data"), str(out), fps=100, jobs=1, options=options)
+    finally:
+        timer.cancel()
+    elapsed = time.perf_counter() - begin
+    assert elapsed < 0.5 + 1.0, f"KeyboardInterrupt came {elapsed - 0.5:.2f} s after the signal"
+    # No output and no staging folder: only the work folder that resume=True reuses.
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left in ([], [".video.evfs-video-work"]), left

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -16,6 +18,12 @@
 
 namespace evfs {
 namespace {
+
+// Every voxel of a video, as one array.
+Eigen::Map<const Eigen::ArrayXd> VoxelValues(const Video& video) {
+  return Eigen::Map<const Eigen::ArrayXd>(video.data(),
+                                          int64_t{video.num_frames()} * video.pixels_per_frame());
+}
 
 // Quality bars on the 48×40 synthetic interpolation scene (frames 0 and 20, truth frame 10):
 // about 1 dB below the gain over the blend that each solver reached when they were set (printed
@@ -225,6 +233,36 @@ TEST(Adam, CallbackSeesEveryIterationAndCanStop) {
   EXPECT_EQ(calls, 4);
   EXPECT_EQ(stopped.iterations, 3);
   EXPECT_NE(stopped.termination.find("callback"), std::string::npos) << stopped.termination;
+}
+
+// A StopCondition ends either solver at its first iteration once reached, with a valid iterate
+// (a time budget of 0 here; an interrupt raises a flag the same way), and says why.
+TEST(FirstOrderSolvers, StopConditionEndsTheSolveWithItsCurrentIterate) {
+  const Problem& problem = SharedProblem();
+  const ActivityMask mask(problem.scene.events, 2);
+  AdamOptions adam = TestOptions<AdamOptions>();
+  adam.max_iterations = 1000000;
+  Video latent = problem.initial;
+  const FirstOrderSummary adam_summary = SolveWithAdam(problem.scene, problem.objective, mask, adam,
+                                                       &latent, nullptr, StopCondition::After(0.0));
+  EXPECT_LE(adam_summary.iterations, 1);
+  EXPECT_FALSE(adam_summary.stopped_early.empty());
+  EXPECT_NE(adam_summary.termination.find("stopped early"), std::string::npos)
+      << adam_summary.termination;
+  EXPECT_TRUE(VoxelValues(latent).allFinite());
+  EXPECT_GE(VoxelValues(latent).minCoeff(), 0.0);
+  EXPECT_LE(VoxelValues(latent).maxCoeff(), 1.0);
+
+  std::atomic<bool> interrupt(true);
+  LbfgsOptions lbfgs = TestOptions<LbfgsOptions>();
+  lbfgs.solver.max_num_iterations = 100000;
+  latent = problem.initial;
+  const FirstOrderSummary lbfgs_summary =
+      SolveWithLbfgs(problem.scene, problem.objective, mask, lbfgs, &latent, nullptr,
+                     StopCondition().WhenRaised(&interrupt));
+  EXPECT_LE(lbfgs_summary.iterations, 1);
+  EXPECT_EQ(lbfgs_summary.stopped_early, "interrupted");
+  EXPECT_TRUE(VoxelValues(latent).allFinite());
 }
 
 TEST(Lbfgs, LowersTheCostAndBeatsTheBlend) {

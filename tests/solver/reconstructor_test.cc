@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -16,6 +18,12 @@
 
 namespace evfs {
 namespace {
+
+// Every voxel of a video, as one array.
+Eigen::Map<const Eigen::ArrayXd> VoxelValues(const Video& video) {
+  return Eigen::Map<const Eigen::ArrayXd>(video.data(),
+                                          int64_t{video.num_frames()} * video.pixels_per_frame());
+}
 
 // Quality bars on the 48×40 synthetic scene, about 2 dB below what the default options reach
 // (printed by the tests: +6.7, +8.0 and +4.3 dB when they were set) so that they catch
@@ -193,6 +201,33 @@ TEST(Reconstructor, IndependentPartsReachTheOneProblemsSolution) {
   std::printf("parts %lld: %.2f dB, one problem %.2f dB\n",
               static_cast<long long>(split.summary.problem.parts), split_psnr, whole_psnr);
   EXPECT_NEAR(split_psnr, whole_psnr, 0.1);
+}
+
+// The whole solve, every part and batch, stops once its StopCondition is reached; what was not
+// solved keeps its start, and nothing is reported as a failure.
+TEST(Reconstructor, StopConditionEndsEveryPartAndKeepsTheStart) {
+  const test::SyntheticRecording recording(/*width=*/120, /*height=*/40);
+  const Scene scene = TwoRegionScene(recording);
+  ReconstructionOptions options = EveryRegionAPart();
+  options.solver.max_num_iterations = 1000;
+  options.solver.function_tolerance = 1e-16;
+  options.stop = StopCondition::After(0.0);
+  const Video initial = InitializeLatentVideo(scene);
+  const Reconstruction stopped = Reconstruct(scene, options, &initial);
+  EXPECT_FALSE(stopped.summary.stopped_early.empty());
+  EXPECT_LE(stopped.summary.iterations, 1);
+  EXPECT_TRUE(VoxelValues(stopped.video).allFinite());
+
+  std::atomic<bool> interrupt(false);
+  options.stop = StopCondition().WhenRaised(&interrupt);
+  int calls = 0;
+  const Reconstruction interrupted =
+      Reconstruct(scene, options, &initial, [&](const SolverIteration&) {
+        if (++calls == 2) interrupt = true;  // raised during the solve, as Ctrl-C would be
+        return true;
+      });
+  EXPECT_EQ(interrupted.summary.stopped_early, "interrupted");
+  EXPECT_LE(interrupted.summary.iterations, 3);
 }
 
 TEST(Reconstructor, CallbackSeesTheWholeObjectiveAcrossParts) {
