@@ -73,10 +73,12 @@ Header ParseHeader(const std::string& path, const uint8_t* data, size_t size) {
     if (header.width > 0 || line_number == 1) continue;
     const std::string lower = Lower(line);
     for (const Chip& chip : kChips) {
-      if (lower.find(chip.name) == std::string::npos) continue;
+      const size_t position = lower.find(chip.name);
+      if (position == std::string::npos) continue;
       header.width = chip.width;
       header.height = chip.height;
-      header.sensor_line = line.substr(0, line.find_last_not_of("\r\n") + 1);
+      // As the line spells it ("DAVIS240C" gives "DAVIS240"): letters and digits only.
+      header.chip = line.substr(position, std::strlen(chip.name));
       if (!chip.davis_address_layout) header.other_address_layout = chip.name;
       break;
     }

@@ -13,10 +13,11 @@ namespace aedat_legacy {
 struct Header {
   int major_version = 0;  // 2 or 3
   size_t data_start = 0;  // first byte after the header
-  // The sensor the header names (0 when it names none) and the line that named it.
+  // The sensor the header names (0 when it names none) and the chip's name as the header spells
+  // it ("DAVIS240", "Davis346").
   int width = 0;
   int height = 0;
-  std::string sensor_line;
+  std::string chip;
   // AEDAT 2.0 only: the name of a chip whose addresses are not in the DAVIS layout ("DVS128"),
   // "" for a DAVIS or an unnamed chip.
   std::string other_address_layout;

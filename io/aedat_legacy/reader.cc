@@ -64,7 +64,7 @@ class AedatLegacyDataSource::File {
     header_ = al::ParseHeader(path(), data_, size_);
     width_ = header_.width;
     height_ = header_.height;
-    if (width_ > 0) size_source_ = "header: " + header_.sensor_line;
+    if (width_ > 0) size_source_ = "the header: chip " + header_.chip;
     if (header_.major_version == 2) {
       IndexVersion2();
     } else {
@@ -132,8 +132,8 @@ class AedatLegacyDataSource::File {
   void IndexVersion2() {
     if (!header_.other_address_layout.empty()) {
       Fail(InputError::Kind::kMalformed,
-           "AEDAT 2.0 from a " + header_.other_address_layout + " ('" + header_.sensor_line +
-               "'): its address layout is not the DAVIS one evfs reads");
+           "AEDAT 2.0 from a " + header_.chip +
+               " (the header names it): its address layout is not the DAVIS one evfs reads");
     }
     const size_t bytes = size_ - header_.data_start;
     if (bytes % al::kRecordBytes != 0) {
