@@ -9,6 +9,7 @@
 #include "core/enum_names.h"
 #include "core/error.h"
 #include "core/time.h"
+#include "io/aedat_legacy.h"
 
 namespace evfs {
 
@@ -16,6 +17,12 @@ void PrintRecording(const DataSource& source, std::FILE* out) {
   const EventSummary events = source.Summarize();
   std::fprintf(out, "data        %s\n", source.path().c_str());
   std::fprintf(out, "resolution  %dx%d\n", source.width(), source.height());
+  // AEDAT 2.0 files of v2e name no chip: the reader then infers the sensor, and says so.
+  if (const auto* legacy = dynamic_cast<const AedatLegacyDataSource*>(&source)) {
+    std::fprintf(out, "format      AEDAT %s (sensor size from %s)\n",
+                 legacy->major_version() == 2 ? "2.0" : "3.1",
+                 legacy->sensor_size_source().c_str());
+  }
   if (source.has_events()) {
     std::fprintf(out, "events      %lld (%lld ON, %lld OFF)\n",
                  static_cast<long long>(events.count), static_cast<long long>(events.positive),

@@ -59,7 +59,8 @@
 // Input and output.
 DEFINE_string(data, "",
               "Data folder (Event Camera Dataset layout), HDF5 event file or AEDAT 4 "
-              "recording (.aedat4, from iniVation DV).");
+              "recording (.aedat4, from iniVation DV), or AEDAT 2.0/3.1 file (jAER, cAER, "
+              "v2e).");
 DEFINE_string(frames, "", "simulate: folder with images.txt ('t path' lines) and the frames.");
 DEFINE_string(out, "",
               "Output folder (reconstruct, simulate, demo) or file (convert to .h5 or .aedat4): "

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "io/aedat4.h"
+#include "io/aedat_legacy.h"
 #include "io/hdf5_io.h"
 #include "io/text_folder.h"
 
@@ -35,6 +36,9 @@ std::unique_ptr<DataSource> DataSource::Open(const std::string& path) {
     return std::make_unique<TextFolderDataSource>(path);
   }
   if (IsHdf5Path(path)) return std::make_unique<Hdf5DataSource>(path);
+  if (StartsWithAedatLegacyVersionLine(path)) {
+    return std::make_unique<AedatLegacyDataSource>(path);
+  }
   // An AEDAT file by its name, or by its version line whatever its name (DV's .aedat4, an older
   // version, which the reader names in its error).
   if (IsAedat4Path(path) || StartsWithAedatVersionLine(path)) {

@@ -504,7 +504,8 @@ PYBIND11_MODULE(evfs, m) {
 
   m.def("read", &evfs::ReadArrays, py::arg("path"),
         "Reads a recording: a data folder (Event Camera Dataset layout), an HDF5 file (.h5) or an "
-        "AEDAT 4 file (.aedat4). Returns a dict: 'frames' (frames x height x width float64 "
+        "AEDAT 4 file (.aedat4), or an AEDAT 2.0/3.1 file (jAER, cAER, v2e). Returns a dict: "
+        "'frames' (frames x height x width float64 "
         "intensities in [0, 1]), 'frame_times' (float64 seconds), 'exposures' (frames x 2 float64 "
         "seconds, begin and end; NaN where unknown), 'frame_paths' (list of str), 'events' (dict "
         "of 't' float64 seconds, 'x', 'y' uint16, 'p' int8 +1/-1), 'width', 'height', 'path'.");

@@ -307,6 +307,48 @@ TEST(EvfsCli, CorruptOrIncompleteHdf5IsAUserError) {
   ExpectUserError(reconstruct(no_frames), no_frames.string() + " has 0 frames", out);
 }
 
+// An AEDAT 3.1 file written by an independent encoder from a folder (tests/io/
+// aedat_legacy_encode.py) reconstructs to the same bytes as the folder with its event times on
+// whole microseconds: every output file but summary.json, which names the input and the run's
+// timings. Malformed and unreadable AEDAT 2.0/3.1 files are one-line user errors.
+TEST(EvfsCli, Aedat31ReconstructsLikeItsFolderAndBadAedatIsAUserError) {
+  EVFS_REQUIRE_SHARED_DATA(data);
+  const fs::path scratch = test::ScratchDir("aedat_legacy_cli");
+  const std::string encode = "/usr/bin/python3 " + std::string(EVFS_TEST_SOURCE_DIR) +
+                             "/../io/aedat_legacy_encode.py " + data + "/slider_depth_70_71 " +
+                             scratch.string();
+  ASSERT_EQ(std::system(encode.c_str()), 0) << encode;
+  const auto reconstruct = [&](const std::string& input, const fs::path& out) {
+    return RunEvfs("reconstruct --data=" + input +
+                   " --mode=interpolate --first=0 --last=1 --out=" + out.string());
+  };
+  ASSERT_EQ(reconstruct((scratch / "us").string(), scratch / "from_folder").exit_code, 0);
+  ASSERT_EQ(reconstruct((scratch / "davis240.aedat3").string(), scratch / "from_aedat3").exit_code,
+            0);
+  int compared = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(scratch / "from_folder")) {
+    const fs::path relative = fs::relative(entry.path(), scratch / "from_folder");
+    if (!entry.is_regular_file() || relative == "summary.json") continue;
+    EXPECT_EQ(test::ReadFile(scratch / "from_aedat3" / relative), test::ReadFile(entry.path()))
+        << relative;
+    ++compared;
+  }
+  EXPECT_GT(compared, 2);
+
+  const fs::path out = scratch / "out";
+  const fs::path truncated = scratch / "truncated.aedat3";
+  fs::copy_file(scratch / "davis240.aedat3", truncated);
+  fs::resize_file(truncated, fs::file_size(truncated) - 5);
+  ExpectUserError(reconstruct(truncated.string(), out), truncated.string() + ": ", out);
+  ExpectUserError(RunEvfs("info --data=" + truncated.string()), "(truncated file?)", out);
+  const fs::path dvs128 = scratch / "dvs128.aedat";
+  test::WriteFile(
+      dvs128.string(),
+      "#!AER-DAT2.0\r\n# AEChip: ch.unizh.ini.jaer.chip.retina.DVS128\r\n" + std::string(8, '\0'));
+  ExpectUserError(RunEvfs("convert --data=" + dvs128.string() + " --out=" + out.string()),
+                  "AEDAT 2.0 from a DVS128", out);
+}
+
 // Two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation fault
 // (in H5AC_protect's block read, and in H5Aexists). The CLI runs HDF5 commands in a child
 // process (app/crash_guard.h), so they end as a user error, not as a crash. Whether libhdf5

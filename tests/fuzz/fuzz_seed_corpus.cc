@@ -8,6 +8,9 @@
 //                    (several packets each, a data table), and the header and first packets
 //                    of the real recordings with their table position set to -1 (no table):
 //                    DV's, and one cut by another tool (its IOHeader aligned differently)
+//   OUT/aedat_legacy/ the first events of every snippet of at most 240x180 pixels as jAER AEDAT
+//                    2.0 (DAVIS240 addresses) and as cAER AEDAT 3.1 (two polarity packets);
+//                    no frames, as a whole-sensor frame alone is 86 KB (3.1) or 1.4 MB (2.0)
 //   OUT/hdf5_io/     tiny recordings cut from the snippets and converted to HDF5 by
 //                    ConvertRecording, the code behind `evfs convert`
 //
@@ -20,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -139,8 +143,47 @@ void WriteRealSeed(const fs::path& aedat4_path, const fs::path& seed_path) {
   WriteText(seed_path, seed.substr(0, std::min(end, file.size())));
 }
 
+// The first kLegacySeedEvents events of `source` as AEDAT 2.0 and 3.1 (io/aedat_legacy/format.h),
+// when they fit a DAVIS240.
+constexpr size_t kLegacySeedEvents = 256;
+
+void WriteAedatLegacySeeds(const DataSource& source, const fs::path& out_stem) {
+  if (source.width() > 240 || source.height() > 180) return;
+  const EventStream events =
+      source.ReadEvents(std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+  const size_t count = std::min(events.size(), kLegacySeedEvents);
+  const auto append = [](std::string* bytes, uint32_t value, bool big_endian) {
+    for (int i = 0; i < 4; ++i) {
+      bytes->push_back(static_cast<char>(value >> (big_endian ? 24 - 8 * i : 8 * i)));
+    }
+  };
+  std::string v2 = "#!AER-DAT2.0\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS240C\r\n";
+  std::string v3 = "#!AER-DAT3.1\r\n#Source 1: DAVIS240C\r\n#!END-HEADER\r\n";
+  for (size_t i = 0; i < count; ++i) {
+    const uint32_t t_us = static_cast<uint32_t>(events.t_ns(i) / 1000);
+    const uint32_t positive = events.polarity(i) > 0 ? 1 : 0;
+    append(&v2,
+           (static_cast<uint32_t>(179 - events.y(i)) << 22) |
+               (static_cast<uint32_t>(239 - events.x(i)) << 12) | (positive << 11),
+           true);
+    append(&v2, t_us, true);
+    if (i % (kLegacySeedEvents / 2) == 0) {
+      const uint32_t number = static_cast<uint32_t>(std::min(count - i, kLegacySeedEvents / 2));
+      v3 += std::string("\x01\x00\x01\x00", 4);
+      for (const uint32_t field : {8u, 4u, 0u, number, number, number}) append(&v3, field, false);
+    }
+    append(&v3,
+           (static_cast<uint32_t>(events.x(i)) << 17) | (static_cast<uint32_t>(events.y(i)) << 2) |
+               (positive << 1) | 1u,
+           false);
+    append(&v3, t_us, false);
+  }
+  WriteText(out_stem.string() + ".aedat2", v2);
+  WriteText(out_stem.string() + ".aedat3", v3);
+}
+
 int Run(const fs::path& data_dir, const fs::path& out) {
-  for (const char* target : {"event_text", "frame_list", "hdf5_io", "aedat4"}) {
+  for (const char* target : {"event_text", "frame_list", "hdf5_io", "aedat4", "aedat_legacy"}) {
     fs::create_directories(out / target);
   }
   std::vector<fs::path> snippets;
@@ -176,6 +219,7 @@ int Run(const fs::path& data_dir, const fs::path& out) {
     WriteTinyRecording(*source, false, kFarFutureNs, out / "hdf5_io" / (name + "_ns.h5"), scratch);
     WriteAedat4Seeds(out / "hdf5_io" / (name + ".h5"), out / "aedat4" / name);
     WriteAedat4Seeds(out / "hdf5_io" / (name + "_ns.h5"), out / "aedat4" / (name + "_ns"));
+    WriteAedatLegacySeeds(*source, out / "aedat_legacy" / name);
   }
   for (const char* folder : {"aedat4_dvxplorer_sample", "aedat4_davis346_street"}) {
     const fs::path recording = data_dir / folder / "sample.aedat4";

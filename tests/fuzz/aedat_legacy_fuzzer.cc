@@ -1,0 +1,67 @@
+// libFuzzer target: AEDAT 2.0 and 3.1 recordings through AedatLegacyDataSource
+// (io/aedat_legacy.h). The reader is handed the input bytes themselves (FromMemory), so
+// AddressSanitizer sees any read past their end. Every input must give a recording or an
+// evfs::Error whose message is one short line. For a recording that opens, every frame and all
+// events are read (each either works or is an evfs::Error); when all events read, the summary
+// and windowed reads (a binary search over the records, or over the packets' time spans) must
+// agree with them.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "core/error.h"
+#include "io/aedat_legacy.h"
+#include "tests/fuzz/fuzz_util.h"
+
+namespace evfs {
+namespace fuzzing {
+namespace {
+
+// The name errors give the input.
+constexpr char kInputName[] = "fuzz/recording.aedat";
+
+void CheckEvents(const AedatLegacyDataSource& source, const EventStream& all) {
+  const EventSummary summary = source.Summarize();
+  Require(summary.count == static_cast<int64_t>(all.size()),
+          "the summary counts other events than the full read");
+  if (all.empty()) return;
+  const size_t last = all.size() - 1;
+  for (size_t i = 0; i <= 2; ++i) {
+    for (size_t j = i; j <= 2; ++j) {
+      const int64_t begin = all.t_ns(i * last / 2);
+      const int64_t end = j == 2 ? After(all.last_t_ns()) : all.t_ns(j * last / 2);
+      for (const int64_t from : {begin, After(begin)}) {
+        Require(source.ReadEvents(from, end) == all.Slice(from, end),
+                "a windowed read differs from slicing the full read");
+      }
+    }
+  }
+}
+
+void FuzzRecording(const uint8_t* data, size_t size) {
+  try {
+    const auto source =
+        AedatLegacyDataSource::FromMemory(kInputName, reinterpret_cast<const char*>(data), size);
+    for (int i = 0; i < static_cast<int>(source->frames().size()); ++i) {
+      try {
+        const Image image = source->ReadImage(i);
+        Require(image.rows() == source->height() && image.cols() == source->width(),
+                "a frame of another size than the sensor");
+      } catch (const Error& error) {
+        CheckMessage(error, kInputName);
+      }
+    }
+    CheckEvents(*source, source->ReadAllEvents());
+  } catch (const Error& error) {
+    CheckMessage(error, kInputName);
+  }
+}
+
+}  // namespace
+}  // namespace fuzzing
+}  // namespace evfs
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  evfs::fuzzing::FuzzRecording(data, size);
+  return 0;
+}
