@@ -2,7 +2,10 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 
 #include "baselines/baseline.h"
 #include "core/error.h"
@@ -146,6 +149,24 @@ bool IsIterative(Method method) {
 bool MethodSupports(Method method, const Scene& scene, std::string* why_not) {
   if (IsIterative(method)) return true;
   return BaselineSupports(AsBaseline(method), scene, why_not);
+}
+
+void CheckResampledOutputFits(double fps, double span_s, int width, int height,
+                              const std::string& what) {
+  constexpr double kBytesPerPixel = 2 * sizeof(double);  // a frame and its confidence map
+  const double frames = std::floor(fps * span_s) + 1.0;
+  const double frame_bytes = kBytesPerPixel * width * height;
+  if (frames * frame_bytes <= kMaxResampledOutputBytes) return;
+  const double most_frames = std::floor(kMaxResampledOutputBytes / frame_bytes);
+  char message[400];
+  std::snprintf(message, sizeof(message),
+                "--fps=%g would resample the %.3f s %s to %.0f frames of %dx%d: %.0f MB with "
+                "their confidence maps, more than the %.0f MB evfs holds for them before "
+                "writing; lower --fps (at most %.0f here)",
+                fps, span_s, what.c_str(), frames, width, height, frames * frame_bytes / 1e6,
+                kMaxResampledOutputBytes / 1e6,
+                span_s > 0.0 ? std::floor(std::max(most_frames - 1.0, 1.0) / span_s) : 0.0);
+  throw InvalidArgumentError(message);
 }
 
 void StartSolveClock(MethodOptions* options) {

@@ -81,6 +81,16 @@ struct MethodOptions {
   const std::atomic<bool>* interrupt = nullptr;
 };
 
+/// Most bytes the resampled frames of one output (or one video window) and their confidence maps
+/// may take in memory (16 bytes a pixel) before they are written.
+inline constexpr double kMaxResampledOutputBytes = 512.0 * (1 << 20);
+
+/// Throws InvalidArgumentError, naming --fps and the largest rate that fits, when resampling
+/// `span_s` seconds (`what`: "window", "longest window") of a width x height sensor at `fps`
+/// would hold more than kMaxResampledOutputBytes.
+void CheckResampledOutputFits(double fps, double span_s, int width, int height,
+                              const std::string& what);
+
 /// Starts the clock of one command's (or one video window's) solve: sets
 /// options->reconstruction.stop to end every solve stage that follows — the method, plug & play
 /// — reconstruction.solver.max_solver_time_in_seconds (--max_time_s) from now, or when

@@ -202,6 +202,9 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
                                " s window to more than " +
                                std::to_string(static_cast<int>(kMaxOutputFrames)) + " frames");
   }
+  if (request.fps > 0.0) {
+    CheckResampledOutputFits(request.fps, window_s, source->width(), source->height(), "window");
+  }
   const EventStream events = source->ReadEvents(window_begin_ns, window_end_ns);
   Image truth_image;
   if (request.truth >= 0) truth_image = source->ReadImage(request.truth);

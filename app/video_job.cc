@@ -621,6 +621,13 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                                std::to_string(result.output_frames) + " frames, more than " +
                                std::to_string(kMaxOutputFrames));
   }
+  // Each window holds its resampled frames and confidence maps until it writes them.
+  int64_t longest_ns = 0;
+  for (const VideoWindow& window : windows) {
+    longest_ns = std::max(longest_ns, window.output_end_ns - window.output_begin_ns);
+  }
+  CheckResampledOutputFits(fps, NanosecondsToSeconds(longest_ns), result.width, result.height,
+                           "longest window");
 
   // The run's fingerprint: what must not change for --resume to reuse windows.
   std::ostringstream fingerprint;
