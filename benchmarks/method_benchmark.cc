@@ -55,9 +55,7 @@ DEFINE_string(cases,
 DEFINE_string(methods, "",
               "Comma-separated methods (ceres_lm, ceres_lbfgs, adam, adam_smooth, blend, copy, "
               "integrate, cf, edi); empty: all.");
-DEFINE_string(clips,
-              "nfs_basketball_7,adobe240_GOPR9637b,adobe240_GOPR9642,adobe240_IMG_0004b,"
-              "adobe240_IMG_0036",
+DEFINE_string(clips, EVFS_BENCHMARK_CLIPS,
               "Ground-truth clips for clip_interpolate and clip_deblur.");
 // ClipCropNote() says why the clips are cropped by default.
 DEFINE_int32(clip_crop_px, 160, "Keep the central N x N pixels of each clip (0: the whole frame).");

@@ -28,8 +28,7 @@ out=$3
 crop=${4:-160}
 shift $(( $# < 4 ? $# : 4 ))
 clips=("$@")
-[ ${#clips[@]} -gt 0 ] || clips=(nfs_basketball_7 adobe240_GOPR9637b adobe240_GOPR9642
-                                 adobe240_IMG_0004b adobe240_IMG_0036)
+[ ${#clips[@]} -gt 0 ] || mapfile -t clips < <(awk '!/^#/ && NF {print $1}' "$(dirname "$0")/clips.txt")
 evfs="$build/examples/evfs"
 mkdir -p "$out"
 out=$(cd "$out" && pwd)

@@ -14,8 +14,8 @@ import json
 import os
 import sys
 
-CLIPS = ["nfs_basketball_7", "adobe240_GOPR9642", "adobe240_GOPR9637b", "adobe240_IMG_0004b",
-         "adobe240_IMG_0036"]
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "clips.txt")) as listing:
+    CLIPS = [line.split()[0] for line in listing if line.strip() and not line.startswith("#")]
 TOLERANCE_DB = 0.1
 
 

@@ -15,8 +15,7 @@ scratch=${2:-/tmp/evfs-whole-clips}
 data=${3:-../shared/data}
 shift $(( $# < 3 ? $# : 3 ))
 clips=("$@")
-[ ${#clips[@]} -gt 0 ] || clips=(nfs_basketball_7 adobe240_GOPR9642 adobe240_GOPR9637b
-                                 adobe240_IMG_0004b adobe240_IMG_0036)
+[ ${#clips[@]} -gt 0 ] || mapfile -t clips < <(awk '!/^#/ && NF {print $1}' "$(dirname "$0")/clips.txt")
 cd "$(dirname "$0")/.."
 evfs="$build/examples/evfs"
 mkdir -p "$scratch"

@@ -38,7 +38,7 @@ for name in vtest.avi tree.avi Megamind.avi; do
 done
 clips=()
 data_dir=${EVFS_DATA_DIR:-$repo/../shared/data}
-for name in nfs_basketball_7 adobe240_GOPR9637b adobe240_GOPR9642; do
+for name in $(awk '!/^#/ && $2 == "training" {print $1}' "$repo/benchmarks/clips.txt"); do
   [ -f "$data_dir/$name/images.txt" ] && clips+=("$data_dir/$name")
 done
 join() { local IFS=,; echo "$*"; }
