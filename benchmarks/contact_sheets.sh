@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Contact sheets of `evfs video` on the real DAVIS recordings (issue 18; docs/guide.md):
+# Contact sheets of `evfs video` on the real DAVIS recordings (docs/guide.md):
 # shapes_rotation_13_20 (interpolation windows, one prediction tail) and eslnet_cups_blur (its
 # six frames observed over their exposures, so deblurred inside the windows).
 #

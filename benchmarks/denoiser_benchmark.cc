@@ -1,4 +1,4 @@
-// The residual denoiser (issue 17): its speed and what it adds to the reconstruction.
+// The residual denoiser: its speed and what it adds to the reconstruction.
 //
 //   denoiser_benchmark [--weights=FILE.onnx] [--data=../shared/data] [--parts=speed,quality]
 //                      [--runs=10] [--csv=FILE] [--out=PICTURE_DIR] [--cases=NAME,...]
@@ -9,7 +9,7 @@
 // speed: ms per 240×180 frame (median of --runs) with 5 %, 25 % and 100 % of the pixels active
 //   (a centred rectangle), for one network on OpenCV's own threads and for one network per
 //   thread (DenoiserOptions::num_threads).
-// quality: the validation cases of issue 17, none of which the trainer may see: adobe240
+// quality: the denoiser's validation cases, none of which the trainer may see: adobe240
 //   IMG_0004b and IMG_0036 (events simulated as `evfs simulate` does) interpolated (frame 2 from
 //   0 and 4) and deblurred (the mean of frames 0–7), slider_depth prediction, shapes_rotation
 //   interpolation (frame 3 from 2 and 4) and eslnet_cups deblur (no truth: re-blur PSNR and

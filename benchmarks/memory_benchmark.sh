@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Peak memory (max RSS, /usr/bin/time -v) and wall time of `evfs info` and `evfs reconstruct` on
-# the hot-pixel and 2 M-event recordings that benchmarks/memory_cases writes (issue 14; the
+# the hot-pixel and 2 M-event recordings that benchmarks/memory_cases writes (the
 # figures are in BENCHMARKS.md, "Memory bounded before allocation").
 #
 #   benchmarks/memory_benchmark.sh [BUILD_DIR] [SCRATCH_DIR] [EVFS_BINARY] [-- EXTRA_FLAGS...]

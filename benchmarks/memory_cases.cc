@@ -1,4 +1,4 @@
-// Writes the recordings that issue 14's memory bound is measured on (BENCHMARKS.md, "Memory
+// Writes the recordings that the memory bound is measured on (BENCHMARKS.md, "Memory
 // bounded before allocation"), as data folders for `evfs info` and `evfs reconstruct`:
 //
 //   OUT/hot_pixel    240x180, a quiet synthetic scene (its events simulated) plus one hot

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# PSNR of `evfs reconstruct` on the quiet windows of issue 16 and the moving windows that must
+# PSNR of `evfs reconstruct` on the quiet windows and the moving windows that must
 # not get worse, one row per configuration (BENCHMARKS.md, "Quiet scenes").
 #
 #   benchmarks/quiet_scenes.sh [BUILD_DIR] [SCRATCH_DIR] [DATA_DIR] -- LABEL [FLAGS...] [-- LABEL [FLAGS...]]...

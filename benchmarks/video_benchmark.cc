@@ -1,4 +1,4 @@
-// `evfs video` at scale (issue 18): throughput with --jobs=1 and --jobs=2, peak memory as the
+// `evfs video` at scale: throughput with --jobs=1 and --jobs=2, peak memory as the
 // recording grows 10x (2 s and 20 s synthetic recordings), and the seams where windows meet.
 //
 // The recordings come from the project's scene synthesizer and event simulator (rendered step

@@ -1,5 +1,5 @@
 // When does a sharp frame happen? Estimating, from the events, the moment an intensity frame
-// represents relative to its timestamp (issue 16, "frame timing").
+// represents relative to its timestamp.
 //
 // A DAVIS frame is exposed over an interval; depending on the recording its timestamp marks the
 // start, the middle or the end of that interval, and the picture is (near) the scene at the
@@ -38,7 +38,8 @@ struct FrameLagOptions {
   /// shift, (r − r0) ≥ f · (1 − r0) with r0 the correlation at zero; otherwise the lag is 0: a
   /// flat correlation curve says little about timing. 0.025: the shapes_rotation 18, 20 pair
   /// peaks at +1.8 ms removing 1.9 % (and shifting by it costs 0.09 dB), while every simulated
-  /// window measured removes 3.2 % or more and gains 0.4 to 0.9 dB (issue 16 report).
+  /// window measured removes 3.2 % or more and gains 0.4 to 0.9 dB (BENCHMARKS.md, "Frame timing of
+  /// sharp frames").
   double min_misfit_reduction = 0.025;
 
   bool IsValid(std::string* error) const;
@@ -85,7 +86,7 @@ FrameLagEstimate EstimateFrameLag(const std::vector<FramePair>& pairs, const Eve
 
 /// What moment a sharp frame of a recording represents relative to its timestamp.
 enum class FrameTime {
-  kInstant,  // the timestamp itself (sharp frames as instants, the model before issue 16)
+  kInstant,  // the timestamp itself (sharp frames as instants, the model before frame timing)
   kAuto,     // the timestamp plus the lag EstimateFrameLag finds (0 when it cannot tell)
   kLag,      // the timestamp plus a lag the user gives
   kStart,    // the frame is the mean over its exposure, which its timestamp starts

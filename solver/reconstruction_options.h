@@ -55,7 +55,7 @@ struct ObjectiveOptions {
   /// texture both frames show costs nothing to keep; an edge only one frame shows there is still
   /// penalised. Scenes without two sharp frames, or whose two frames' differences do not
   /// correlate positively (ObjectiveTerms::shared_structure_correlation), keep plain TV. On by
-  /// default: with the step ramps it lifts every quiet window of issue 16 above the blend and
+  /// default: with the step ramps it lifts every quiet window above the blend and
   /// event integration (GOPR9642 24, 28 → 26 by 1.1 dB) and no window the issue lists gets
   /// worse (BENCHMARKS.md, "Spatial TV of what the frames do not share").
   bool shared_structure_tv = true;

@@ -5,7 +5,7 @@
 // them, within one latent step. A pixel integrates light over its area, so even a perfectly
 // sharp edge crossing it changes its value over the time the edge takes to move one pixel, and
 // a blurred edge over longer: the change is a ramp whose length is set by the local speed, not
-// a jump. Where the scene moves slowly (the quiet windows of issue 16) that time is a large part
+// a jump. Where the scene moves slowly (the quiet windows) that time is a large part
 // of the window, and the step model puts the pixel at one of its two values where the truth is
 // between them.
 //

@@ -1,4 +1,4 @@
-// make_denoiser_pairs: the training pairs of the residual denoiser (paper §3.4, issue 17), made
+// make_denoiser_pairs: the training pairs of the residual denoiser (paper §3.4), made
 // by evfs itself. Each sample takes a short ground-truth clip from one of the sources, simulates
 // its events, reconstructs one of the three cases with the DMR (Ceres LM, app/method.h) under a
 // configuration randomised as the paper's Table 3 does, and writes a few

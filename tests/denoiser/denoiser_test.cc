@@ -29,7 +29,7 @@ constexpr double kFloatTolerance = 1e-5;
 // A tile and the whole frame sum the same products, possibly in another order (vectorised
 // loops over rows of another length): float32 rounding of values of order 1.
 constexpr double kTileTolerance = 1e-6;
-// Issue 17's bound for the C++ inference against the trainer's PyTorch output: the two run the
+// The bound for the C++ inference against the trainer's PyTorch output: the two run the
 // same float32 network with other summation orders.
 constexpr double kTorchTolerance = 1e-4;
 constexpr double kRelativeTorchTolerance = 1e-3;

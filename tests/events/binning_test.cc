@@ -435,7 +435,7 @@ TEST(BinStacked, RejectsInvalidOptionsAndShortWindows) {
   EXPECT_NE(error.find("num_frames * steps_per_frame"), std::string::npos) << error;
 }
 
-// Regression (issue 14): a window too short for the frames was found only after allocating one
+// Regression: a window too short for the frames was found only after allocating one
 // boundary per frame (16 GB for 2^31 - 2 frames); it is refused first.
 TEST(BinStacked, ShortWindowIsRefusedBeforeAllocating) {
   const EventStream events = RandomEvents(10, 0, 100, kSeed);

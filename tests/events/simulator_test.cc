@@ -149,7 +149,7 @@ TEST(EventSimulator, NoiseRateGivesTheExpectedCount) {
   EXPECT_LE(events.last_t_ns(), kNanosecondsPerSecond);
 }
 
-// Regression (issue 14): noise_rate_hz = 1e12 drew events until memory ran out (bad_alloc). The
+// Regression: noise_rate_hz = 1e12 drew events until memory ran out (bad_alloc). The
 // expected count is known before drawing, so it is refused at once, for the whole video and
 // for one Advance alike.
 TEST(EventSimulator, NoiseBeyondTheEventBudgetIsRefusedBeforeDrawing) {

@@ -1,4 +1,4 @@
-// evfs reconstruct --denoise / --denoiser and evfs denoise, end to end (issue 17), with the
+// evfs reconstruct --denoise / --denoiser and evfs denoise, end to end, with the
 // hand-checkable network of tests/denoiser/data (its values are checked in denoiser_test.cc).
 #include <gtest/gtest.h>
 

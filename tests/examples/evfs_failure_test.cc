@@ -1,6 +1,6 @@
 // How `evfs` fails, end to end: whose fault each failure is (exit status 2 for the user's, 3 for
 // evfs' own bugs, 4 for a solver that failed), that each is one line saying what is wrong, and
-// that a long command reports progress wherever stderr goes (issue 14, "Failure semantics").
+// that a long command reports progress wherever stderr goes.
 // Each test works in a scratch folder of its own.
 #include <gtest/gtest.h>
 #include <sys/stat.h>

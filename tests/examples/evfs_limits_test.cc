@@ -1,4 +1,4 @@
-// End-to-end tests of issue 14's "memory and time bounded before allocation": what a hostile or
+// End-to-end tests of the "memory and time bounded before allocation": what a hostile or
 // unlucky input (a hot pixel, a binning beyond the voxel cap, a file declaring a huge sensor, a
 // flag that overflows arithmetic) makes of `evfs`. Each case is small enough to run in well
 // under a second, yet failed (allocated gigabytes, looped, crashed) before the fix.
@@ -69,7 +69,7 @@ std::string WriteHotPixelFolder(const std::string& scratch, int count) {
   return folder;
 }
 
-// Regression (issue 14): one pixel firing a thousand times made `info` and `reconstruct` bin a
+// Regression: one pixel firing a thousand times made `info` and `reconstruct` bin a
 // thousand collision frames of the whole sensor. Its events are left out, and both say so.
 TEST(EvfsLimits, HotPixelIsLeftOutAndReported) {
   const std::string scratch = test::ScratchDir("limits_hot_pixel");
@@ -128,7 +128,7 @@ TEST(EvfsLimits, InfoReportsCollisionFramesSplitInTime) {
                   scratch + "/never");
 }
 
-// Regression (issue 14): --max_latent_voxels bounded auto binning only, after the collision
+// Regression: --max_latent_voxels bounded auto binning only, after the collision
 // frames were allocated; an explicit --binning beyond it was built whatever its size. It is
 // now a user error in every mode and in `info`, before anything is allocated.
 TEST(EvfsLimits, ExplicitBinningBeyondTheVoxelCapIsAUserError) {
@@ -171,7 +171,7 @@ TEST(EvfsLimits, ExplicitBinningBeyondTheVoxelCapIsAUserError) {
       "needs at least 2 latent frames", out);
 }
 
-// Regression (issue 14): a sensor_resolution of 65535x65535 made `info --first --last` allocate
+// Regression: a sensor_resolution of 65535x65535 made `info --first --last` allocate
 // for 4 G pixels (bad_alloc, or the machine's memory). It is a one-line user error now, and so
 // is a declared size the frames do not have.
 TEST(EvfsLimits, HugeDeclaredSensorIsAUserError) {
@@ -192,7 +192,7 @@ TEST(EvfsLimits, HugeDeclaredSensorIsAUserError) {
                   "the sensor is 4096x4096", scratch + "/never");
 }
 
-// Regression (issue 14): --fps below ~1e-10 made the resampling's int64 arithmetic wrap, and it
+// Regression: --fps below ~1e-10 made the resampling's int64 arithmetic wrap, and it
 // looped forever, allocating. A rate below one frame per window gives the first frame alone.
 TEST(EvfsLimits, TinyFpsGivesOneFrame) {
   const std::string scratch = test::ScratchDir("limits_fps");
@@ -214,7 +214,7 @@ TEST(EvfsLimits, TinyFpsGivesOneFrame) {
       "--fps", scratch + "/out");
 }
 
-// Regression (issue 14): --activity_radius_px of 2^31 - 239 or more overflowed int in the
+// Regression: --activity_radius_px of 2^31 - 239 or more overflowed int in the
 // dilation of the activity mask (SIGSEGV). Any radius beyond the sensor solves every pixel.
 TEST(EvfsLimits, HugeActivityRadiusSolvesEveryPixel) {
   const std::string scratch = test::ScratchDir("limits_radius");
@@ -233,7 +233,7 @@ TEST(EvfsLimits, HugeActivityRadiusSolvesEveryPixel) {
   }
 }
 
-// Regression (issue 14): simulate --noise_rate_hz=1e12 drew noise events until memory ran out
+// Regression: simulate --noise_rate_hz=1e12 drew noise events until memory ran out
 // (bad_alloc, exit 1). The expected count is known before drawing: a one-line user error.
 TEST(EvfsLimits, NoiseBeyondTheEventBudgetIsAUserError) {
   const std::string scratch = test::ScratchDir("limits_noise");

@@ -1,5 +1,5 @@
 // What `evfs` may write and replace, end to end: every command that writes, against the cases
-// that once deleted user files (issue 14). Each test works in a sandbox folder of its own, with
+// that once deleted user files. Each test works in a sandbox folder of its own, with
 // stand-ins for the home folder, the current folder and the input; no test names a real system
 // path as --out.
 #include <gtest/gtest.h>

@@ -634,8 +634,8 @@ TEST(Aedat4RealSampleTest, SharedFoldersConvertLosslesslyToTheMicrosecond) {
   }
 }
 
-// The acceptance test of issue 19: every shared data folder, text → AEDAT 4 → text through
-// ConvertRecording (the code of `evfs convert`), is the same recording to the microsecond,
+// The acceptance test of the AEDAT 4 round trip: every shared data folder, text → AEDAT 4 → text
+// through ConvertRecording (the code of `evfs convert`), is the same recording to the microsecond,
 // AEDAT 4's resolution, with its frames exact. A folder of frames only comes back as one (no
 // events.txt); HDF5, whose layout holds events, refuses it with one line naming `evfs simulate`.
 TEST(Aedat4RealSampleTest, SharedFoldersRoundTripTextToAedat4ToText) {

@@ -422,7 +422,7 @@ TEST(Hdf5IoTest, ImageOfAnotherSizeThanTheSensorIsAnInputError) {
   recording.images[1] = test::MakeRandomImage(4, kWidth + 1, kHeight, 8);
   const std::string path = test::ScratchDir("h5_size") + "/recording.h5";
   WriteHdf5(path, recording.events, recording.frames, recording.images);
-  // Found when the file opens, before any frame is read (issue 14).
+  // Found when the file opens, before any frame is read.
   test::ExpectInputError([&] { Hdf5DataSource source(path); }, InputError::Kind::kSizeMismatch,
                          "images/image000000001", 0);
 }
@@ -477,7 +477,7 @@ TEST(Hdf5IoTest, ImageExtentBeyondIntIsAnInputError) {
                          "images/image000000001 is 64x4294967344", 0);
 }
 
-// Regression (issue 14): a sensor_resolution of 65535x65535 over 64x48 frames was trusted until
+// Regression: a sensor_resolution of 65535x65535 over 64x48 frames was trusted until
 // a frame was read, and `evfs info --first` allocated for its 4 G pixels first (bad_alloc).
 // Declared sizes are checked against the frames and bounded when the file opens.
 TEST(Hdf5IoTest, DeclaredSensorSizeIsCheckedBeforeAllocating) {

@@ -123,7 +123,7 @@ TEST(Scene, AutoBinningKeepsWithinTheVoxelBudget) {
   });
 }
 
-// Regression (issue 14): an explicit binning beyond the voxel cap used to be built whatever its
+// Regression: an explicit binning beyond the voxel cap used to be built whatever its
 // size; it is now refused before any frame is allocated.
 TEST(Scene, ExplicitBinningBeyondTheVoxelCapIsRefused) {
   const test::SyntheticRecording recording;
@@ -220,7 +220,7 @@ TEST(Scene, AutoBinningSplitsFewCollisionFramesUpToMinLatentSteps) {
   }
 }
 
-// Regression (issue 14): one pixel firing a thousand times in a quiet window made collision
+// Regression: one pixel firing a thousand times in a quiet window made collision
 // binning open a thousand frames of the whole sensor (auto binning then fell back to stacked
 // frames). Its events are now left out as hot, and the scene is the one without it.
 TEST(Scene, HotPixelDoesNotMultiplyTheLatentSteps) {
@@ -250,7 +250,7 @@ TEST(Scene, HotPixelDoesNotMultiplyTheLatentSteps) {
   EXPECT_EQ(kept.num_events, clean.num_events + 1000);
 }
 
-// The background-activity filter (issue 16) runs before binning: isolated events added to a
+// The background-activity filter runs before binning: isolated events added to a
 // recording are left out and counted, the recording's own edges are kept, and a filtered event
 // neither fires a pixel nor opens a collision frame.
 TEST(Scene, NoiseFilterLeavesOutIsolatedEventsBeforeBinning) {
@@ -401,7 +401,7 @@ TEST(Scene, FlickeringPixelNextToSaturationLeavesItsEventsToTheFrames) {
 
 #if !defined(__SANITIZE_ADDRESS__) && !EVFS_HAS_FEATURE(address_sanitizer) && \
     !EVFS_HAS_FEATURE(memory_sanitizer) && !defined(__SANITIZE_THREAD__)
-// Regression (issue 14): the binning allocated collision frames × pixels before the voxel cap
+// Regression: the binning allocated collision frames × pixels before the voxel cap
 // applied, so 300 events at one pixel of a 2048 x 2048 sensor asked for 300 frames of 4 M pixels
 // (5 GB). Run in a child process limited to 1 GB of address space: it must finish there.
 TEST(Scene, MemoryIsBoundedBeforeAllocating) {

@@ -210,7 +210,7 @@ TEST(ActivityMask, IndependentPartsAreConnectedRegionsOfTheProblem) {
   EXPECT_EQ(mask.IndependentParts(41).front().size(), 65u);
 }
 
-// Regression (issue 14): a radius of 2^31 - 239 or more overflowed int in the dilation and
+// Regression: a radius of 2^31 - 239 or more overflowed int in the dilation and
 // crashed (SIGSEGV). Any radius beyond the sensor makes every pixel active, like the sensor size.
 TEST(ActivityMask, RadiusBeyondTheSensorMakesEveryPixelActive) {
   const Scene scene = MakeSceneWithEvents(6, 18, {{0, 2, 2}});

@@ -1,4 +1,4 @@
-// Sweeps of the objective's parameters (issue 6): α, the smoothing scale ε, each term's weight
+// Sweeps of the objective's parameters: α, the smoothing scale ε, each term's weight
 // and the log event model's offset b, each run checked by ExpectStableReconstruction.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Degenerate scenes (issue 6) under both event models, reconstructed by the solver and by every
+// Degenerate scenes under both event models, reconstructed by the solver and by every
 // classical baseline that supports them: black, white and saturated intensities, a constant
 // image, a single pixel row, no events, every pixel firing at every step, one and 500 latent
 // frames, contradictory events and events that disagree with the frames.

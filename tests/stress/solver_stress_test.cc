@@ -1,4 +1,4 @@
-// The solvers under stress (issue 6): Ceres' minimisers and linear solvers through Reconstruct,
+// The solvers under stress: Ceres' minimisers and linear solvers through Reconstruct,
 // and the first-order solvers (Adam on the true and the smoothed ℓ1, Ceres' L-BFGS) on the
 // fused objective, each on scenes and settings from the other stress sweeps.
 #include <gtest/gtest.h>

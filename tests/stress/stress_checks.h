@@ -1,4 +1,4 @@
-// The properties every stress run must keep (issue 6): nothing NaN or infinite (costs, the
+// The properties every stress run must keep: nothing NaN or infinite (costs, the
 // gradient of the built Ceres problem, the output video), a final cost not above the initial,
 // intensities within [0, 1] when bounded, and a PSNR against the truth not below the
 // initialisation's by more than a stated margin.

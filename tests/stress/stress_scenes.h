@@ -1,4 +1,4 @@
-// Scenes with a known truth for the numerical-stability sweeps (issue 6): small enough that the
+// Scenes with a known truth for the numerical-stability sweeps: small enough that the
 // whole stress suite runs in seconds, built either by the simulator (moving shapes) or by hand
 // from a truth video through an ideal event sensor, so that degenerate cases (black, white,
 // one row, every pixel firing, 500 latent frames, contradictory events) are exactly what they
