@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "app/frame_consistency.h"
+#include "app/run_report.h"
 #include "app/video_writer.h"
 #include "core/error.h"
 #include "core/metrics.h"
@@ -836,6 +837,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                     {"events_per_s", Number(result.events_per_s)}};
   summary["windows"] = std::move(window_records);
   WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  if (request.report) WriteRunReport(out.string());
   remove_on_error.armed = false;
   return result;
 }
