@@ -261,10 +261,28 @@ std::string RenderRunReport(const std::string& summary_json,
   }
   if (summary.contains("model")) model["run"] = summary["model"];
 
+  // The command line's settings, "name=value name=value ...", one row each; the event model's
+  // own (thresholds, log offset, model) also go to the model's table.
   Json settings = Json::object();
+  Json flags = Json::object();
   for (auto it = summary.begin(); it != summary.end(); ++it) {
-    if (it.key() != "windows" && it.key() != "exposures") settings[it.key()] = *it;
+    if (it.key() == "settings" && it->is_string()) {
+      std::istringstream words(it->get<std::string>());
+      std::string word;
+      while (words >> word) {
+        const size_t equals = word.find('=');
+        const std::string name = word.substr(0, equals);
+        const std::string value = equals == std::string::npos ? "" : word.substr(equals + 1);
+        flags[name] = value;
+        for (const char* topic : {"threshold", "log_offset", "model", "contrast", "sigma_"}) {
+          if (name.find(topic) != std::string::npos) model[name] = value;
+        }
+      }
+    } else if (it.key() != "windows" && it.key() != "exposures") {
+      settings[it.key()] = *it;
+    }
   }
+  if (!flags.empty()) settings["flags"] = flags;
 
   std::string page;
   page += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
@@ -305,6 +323,9 @@ if (location.hash === '#selfcheck') {
       report.video_time = video ? video.currentTime : -1;
       report.resources = performance.getEntriesByType('resource').map(function (e) {
         return e.name;
+      });
+      document.querySelectorAll('[src],[href]').forEach(function (element) {
+        report.resources.push(element.src || element.href);
       });
       document.getElementById('selfcheck').textContent = 'SELFCHECK ' + JSON.stringify(report);
     };

@@ -376,6 +376,8 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["solved"] = run.solved;
   record["message"] = run.message;
   record["iterations"] = run.iterations;
+  if (!run.reconstruction.model.description.empty())
+    record["model"] = run.reconstruction.model.description;
   record["initial_cost"] = Number(run.initial_cost);
   record["final_cost"] = Number(run.final_cost);
   // With --denoise=once: the fraction of the denoiser's correction this window's frames had
@@ -803,6 +805,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
   if (request.preview) summary["preview"] = "preview.mp4";
   summary["solver"] = MethodName(request.method.method);
+  summary["settings"] = request.settings;
   summary["denoiser"] =
       denoiser != nullptr ? NameOf(kDenoiseModeNames, request.denoise.mode) : "none";
   summary["events"] = result.events;

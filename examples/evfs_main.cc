@@ -600,7 +600,7 @@ int RunReconstruct(ProgressReporter* progress) {
 // flags but those that only say where, how fast or how verbosely.
 std::string VideoSettings() {
   static const char* const kNotSettings[] = {
-      "out", "overwrite", "resume", "jobs", "threads", "progress", "progress_interval_s"};
+      "out", "overwrite", "resume", "jobs", "threads", "progress", "progress_interval_s", "report"};
   std::string settings;
   std::vector<gflags::CommandLineFlagInfo> flags;
   gflags::GetAllFlags(&flags);
