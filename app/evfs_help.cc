@@ -22,6 +22,7 @@ ProgramHelp MakeEvfsHelp() {
        "(paper §3), into OUT with their timestamps and a summary."},
       {"video",
        "--data=DIR --out=OUT [--fps=N] [--first=I --last=J] [--jobs=N] [--resume] [--preview] "
+       "[--report] "
        "[method, binning, model and solver flags]",
        "Reconstruct a whole recording, window by window and in parallel, into one video at a "
        "uniform rate: OUT/frames, timestamps.txt, summary.json and video.mp4."},
@@ -125,6 +126,7 @@ ProgramHelp MakeEvfsHelp() {
       {"jobs", "solver", "video"},
       {"resume", "output", "video"},
       {"preview", "output", "video"},
+      {"report", "output", "video"},
       {"predict_tail", "data", "video"},
       {"predict_max_s", "data", "video"},
       {"min_blur_exposure_s", "data", "video"},

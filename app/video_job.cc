@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "app/frame_consistency.h"
+#include "app/run_report.h"
 #include "app/video_writer.h"
 #include "core/error.h"
 #include "core/metrics.h"
@@ -381,6 +382,8 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["solved"] = run.solved;
   record["message"] = run.message;
   record["iterations"] = run.iterations;
+  if (!run.reconstruction.model.description.empty())
+    record["model"] = run.reconstruction.model.description;
   record["initial_cost"] = Number(run.initial_cost);
   record["final_cost"] = Number(run.final_cost);
   // With --denoise=once: the fraction of the denoiser's correction this window's frames had
@@ -826,6 +829,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
   if (request.preview) summary["preview"] = "preview.mp4";
   summary["solver"] = MethodName(request.method.method);
+  summary["settings"] = request.settings;
   summary["denoiser"] =
       denoiser != nullptr ? NameOf(kDenoiseModeNames, request.denoise.mode) : "none";
   summary["events"] = result.events;
@@ -860,6 +864,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                     {"events_per_s", Number(result.events_per_s)}};
   summary["windows"] = std::move(window_records);
   WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  if (request.report) WriteRunReport(out.string());
   remove_on_error.armed = false;
   return result;
 }

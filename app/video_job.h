@@ -75,6 +75,7 @@ struct VideoRequest {
   bool skip_bad_frames = false;  // leave unreadable frames out instead of failing
   bool resume = false;           // reuse the windows an interrupted run finished
   bool preview = false;          // also preview.mp4: observed | reconstruction | events
+  bool report = false;           // also report.html: the run on one offline page
   BinningOptions binning;
   MethodOptions method;  // solver threads are set per window from threads_per_window
   DenoiseRequest denoise;

@@ -4,7 +4,7 @@
 //   evfs reconstruct --data=DIR --mode=interpolate|predict|deblur --first=I [--last=J]
 //                    [--truth=K] --out=OUT [solver and model flags]
 //   evfs video       --data=DIR --out=OUT [--fps=N --first=I --last=J --jobs=N --resume
-//                    --preview] [solver and model flags]
+//                    --preview] [--report] [solver and model flags]
 //   evfs denoise     --in=RECONSTRUCTION_DIR --out=DIR [--denoiser=FILE.onnx]
 //   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
 //                    [sensor effects, light sources and frame effects]
@@ -266,6 +266,9 @@ DEFINE_bool(resume, false,
 DEFINE_bool(preview, false,
             "video: also preview.mp4, side by side: last observed frame | reconstruction | the "
             "step's events (red ON, blue OFF).");
+DEFINE_bool(report, false,
+            "video: also report.html, one offline page of the run: the video and preview, "
+            "events, iterations, solve time and PSNR per window, confidence maps, settings.");
 DEFINE_bool(predict_tail, true,
             "video: predict after the recording's last frame up to the last event.");
 DEFINE_double(predict_max_s, 0.0,
@@ -602,7 +605,7 @@ int RunReconstruct(ProgressReporter* progress) {
 // flags but those that only say where, how fast or how verbosely.
 std::string VideoSettings() {
   static const char* const kNotSettings[] = {
-      "out", "overwrite", "resume", "jobs", "threads", "progress", "progress_interval_s"};
+      "out", "overwrite", "resume", "jobs", "threads", "progress", "progress_interval_s", "report"};
   std::string settings;
   std::vector<gflags::CommandLineFlagInfo> flags;
   gflags::GetAllFlags(&flags);
@@ -644,6 +647,7 @@ int RunVideoCommand(ProgressReporter* progress) {
   request.skip_bad_frames = FLAGS_skip_bad_frames;
   request.resume = FLAGS_resume;
   request.preview = FLAGS_preview;
+  request.report = FLAGS_report;
   request.binning = reconstruct.binning;
   request.method = reconstruct.method;
   request.denoise = reconstruct.denoise;

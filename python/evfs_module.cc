@@ -414,8 +414,8 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
 // process: a signal leaves the staging folder, and the resumable work folder, behind.
 py::dict VideoFromPath(const std::string& data, const std::string& out, const py::int_& first,
                        const py::int_& last, double fps, const py::int_& jobs,
-                       const py::int_& frame_step, bool predict_tail, bool preview, bool resume,
-                       bool overwrite, py::handle options) {
+                       const py::int_& frame_step, bool predict_tail, bool preview, bool report,
+                       bool resume, bool overwrite, py::handle options) {
   ReconstructSettings settings = DefaultReconstructSettings();
   ApplyReconstructOptions(options, &settings);
   ResolveDenoise(&settings);
@@ -428,6 +428,7 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   request.fps = fps;
   request.jobs = IntArgument(jobs, "jobs");
   request.preview = preview;
+  request.report = report;
   request.resume = resume;
   request.binning = settings.request.binning;
   request.method = settings.request.method;
@@ -531,10 +532,12 @@ PYBIND11_MODULE(evfs, m) {
   m.def("video", &evfs::VideoFromPath, py::arg("data"), py::arg("out"), py::kw_only(),
         py::arg("first") = 0, py::arg("last") = -1, py::arg("fps") = 0.0, py::arg("jobs") = 0,
         py::arg("frame_step") = 1, py::arg("predict_tail") = true, py::arg("preview") = false,
-        py::arg("resume") = false, py::arg("overwrite") = false, py::arg("options") = py::none(),
+        py::arg("report") = false, py::arg("resume") = false, py::arg("overwrite") = false,
+        py::arg("options") = py::none(),
         "A whole recording (`data`: a path read() accepts) to one high-framerate video in the "
         "folder `out`, as `evfs video` does (without MPI): out/frames/NNNNNN.png at a uniform "
-        "`fps` (0: 10x the frame rate), timestamps.txt, summary.json, video.mp4. first/last "
+        "`fps` (0: 10x the frame rate), timestamps.txt, summary.json, video.mp4 (report: also "
+        "report.html). first/last "
         "select frames (-1: the last), jobs windows run at once (0: every core), frame_step > 1 "
         "withholds frames and scores them, resume reuses an interrupted run's windows, "
         "overwrite replaces an earlier evfs video output. options: reconstruct_defaults()'s "

@@ -4,6 +4,7 @@
 # With --fuzz it also installs clang and its libFuzzer runtime (for `make fuzz` only).
 # With --train it also installs what training the residual denoiser needs (`make train-denoiser`
 # only): PyTorch, ONNX, OpenCV's Python module, and the images and videos it trains on.
+# With --with-browser it also installs Chromium, which report_browser_test opens report.html in.
 set -euo pipefail
 
 packages=(
@@ -26,6 +27,9 @@ packages=(
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-dev)
+fi
+if [ "${1:-}" = "--with-browser" ]; then
+  packages+=(chromium)
 fi
 if [ "${1:-}" = "--train" ]; then
   packages+=(python3-torch python3-onnx python3-opencv python3-numpy opencv-doc python3-skimage)
