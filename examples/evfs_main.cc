@@ -24,8 +24,10 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <new>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "app/allocator_tuning.h"
@@ -82,7 +84,9 @@ DEFINE_double(exposure_s, 0.0,
               "the scene over it (with exposures.txt); 0: the scene at the timestamp.");
 DEFINE_double(fps, 0.0,
               "Resample the latent video to this uniform frame rate; 0 writes the "
-              "latent frames themselves.");
+              "latent frames themselves. reconstruct: at most 10000 frames, and at most 1 GiB "
+              "for the frames and their confidence maps (8 bytes a pixel each); a larger rate "
+              "is refused before the solve.");
 DEFINE_string(frame_time, "instant",
               "interpolate, predict: the moment a sharp frame represents. instant: its "
               "timestamp; auto: its timestamp plus the lag that best explains the input frames' "
@@ -643,6 +647,9 @@ int RunVideoCommand(ProgressReporter* progress) {
   request.method = reconstruct.method;
   request.denoise = reconstruct.denoise;
   request.settings = VideoSettings();
+  request.notice = [](const std::string& line) {
+    std::fprintf(stderr, "evfs video: %s\n", line.c_str());
+  };
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
   // Under mpirun: rank 0 writes, the other ranks solve the windows it hands out.
@@ -883,6 +890,18 @@ int main(int argc, char** argv) {
     } catch (const evfs::Error& error) {
       std::fprintf(stderr, "evfs %s: %s\n", command.c_str(), error.what());
       return 2;
+    } catch (const std::bad_alloc&) {
+      // Memory beyond what the machine (or ulimit -v) gives, past every limit checked from
+      // the declared sizes: one line and kExitUnexpected (core/error.h).
+      std::fprintf(stderr,
+                   "evfs %s: out of memory (a smaller window, --fps, --jobs or input, or more "
+                   "memory)\n",
+                   command.c_str());
+      return static_cast<int>(evfs::kExitUnexpected);
+    } catch (const std::system_error& error) {
+      std::fprintf(stderr, "evfs %s: the system refused a resource: %s\n", command.c_str(),
+                   error.what());
+      return static_cast<int>(evfs::kExitUnexpected);
     } catch (const std::exception& error) {
       std::fprintf(stderr, "evfs %s: unexpected error: %s\n", command.c_str(), error.what());
       return 1;
