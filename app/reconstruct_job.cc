@@ -23,17 +23,8 @@ using Clock = std::chrono::steady_clock;
 
 // Most frames --fps may resample the latent video to (a runaway rate would fill memory).
 constexpr double kMaxOutputFrames = 10000;
-// Most memory the frames --fps resamples to and their confidence maps may take.
-constexpr double kMaxOutputBytes = 1 << 30;
 // Longest --exposure_s: keeps t +- exposure / 2 far inside int64 nanoseconds.
 constexpr double kMaxExposureS = 3600.0;
-
-// A value as %g writes it: "20000", "0.104", "1.4e+04".
-std::string FormatNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
 
 void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   const int count = static_cast<int>(source.frames().size());
@@ -213,17 +204,6 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
     throw InvalidArgumentError("--fps would resample the " + std::to_string(window_s) +
                                " s window to more than " +
                                std::to_string(static_cast<int>(kMaxOutputFrames)) + " frames");
-  }
-  // The resampled video and its confidence maps are held in memory, 8 bytes a pixel each.
-  const double output_bytes = (request.fps * window_s + 1.0) * 2.0 * sizeof(double) *
-                              static_cast<double>(source->width()) * source->height();
-  if (request.fps > 0.0 && output_bytes > kMaxOutputBytes) {
-    throw InvalidArgumentError(
-        "--fps=" + FormatNumber(request.fps) + " would resample the " + FormatNumber(window_s) +
-        " s window at " + std::to_string(source->width()) + "x" + std::to_string(source->height()) +
-        " to " + FormatNumber(output_bytes / (1 << 20)) +
-        " MiB of frames and confidence maps, more than the " +
-        std::to_string(static_cast<int64_t>(kMaxOutputBytes) >> 20) + " MiB limit");
   }
   const EventStream events = source->ReadEvents(window_begin_ns, window_end_ns);
   Image truth_image;

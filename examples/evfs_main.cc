@@ -84,9 +84,7 @@ DEFINE_double(exposure_s, 0.0,
               "the scene over it (with exposures.txt); 0: the scene at the timestamp.");
 DEFINE_double(fps, 0.0,
               "Resample the latent video to this uniform frame rate; 0 writes the "
-              "latent frames themselves. reconstruct: at most 10000 frames, and at most 1 GiB "
-              "for the frames and their confidence maps (8 bytes a pixel each); a larger rate "
-              "is refused before the solve.");
+              "latent frames themselves.");
 DEFINE_string(frame_time, "instant",
               "interpolate, predict: the moment a sharp frame represents. instant: its "
               "timestamp; auto: its timestamp plus the lag that best explains the input frames' "
