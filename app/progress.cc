@@ -1,12 +1,19 @@
 #include "app/progress.h"
 
 #include <cstdarg>
+#include <system_error>
 #include <utility>
 
 namespace evfs {
 
 ProgressReporter::ProgressReporter(ProgressOptions options) : options_(std::move(options)) {
-  if (options_.interval_s > 0.0) thread_ = std::thread([this] { Run(); });
+  if (options_.interval_s <= 0.0) return;
+  // Progress lines are a convenience: without a thread for them (no address space for its
+  // stack, a thread limit) the command runs on silently.
+  try {
+    thread_ = std::thread([this] { Run(); });
+  } catch (const std::system_error&) {
+  }
 }
 
 ProgressReporter::~ProgressReporter() {

@@ -149,6 +149,9 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   const DataSource* source = given != nullptr ? given : opened.get();
   result.width = source->width();
   result.height = source->height();
+  // From the declared size, before a frame is decoded: a large declared sensor with small
+  // compressed frames would otherwise cost its full size in memory first.
+  CheckSensorFitsLatentVoxels(result.width, result.height, request.binning);
   CheckFrameIndex(*source, request.first, "the first");
   const int last = request.last >= 0 ? request.last : request.first + 1;
   if (request.mode != Mode::kDeblur) {

@@ -1,5 +1,7 @@
 #include "app/video_job.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -538,6 +540,44 @@ std::string VideoProgressLine(const VideoProgress& progress) {
   return line + text;
 }
 
+int64_t AddressSpaceLimit() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 0;
+  return static_cast<int64_t>(std::min<rlim_t>(limit.rlim_cur, INT64_MAX));
+}
+
+int CapVideoJobs(int jobs, int windows, int cores, int threads_per_window, int64_t pixels,
+                 int64_t address_space_bytes, std::string* why) {
+  int capped = std::max(jobs, 1);
+  const auto lower = [&](int64_t most, const std::string& reason) {
+    most = std::max<int64_t>(most, 1);
+    if (capped > most) {
+      capped = static_cast<int>(most);
+      *why = reason;
+    }
+  };
+  lower(static_cast<int64_t>(cores) * kMaxJobsPerCore,
+        "at most " + std::to_string(kMaxJobsPerCore) + " per hardware thread (" +
+            std::to_string(cores) + ")");
+  if (address_space_bytes > 0) {
+    // Each job reserves its threads' stacks and holds its window's frames, events and problem;
+    // the rest of the address space is the process' own (libraries, the recording's index).
+    rlimit stack{};
+    int64_t stack_bytes = kDefaultThreadStackBytes;
+    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY) {
+      stack_bytes = static_cast<int64_t>(stack.rlim_cur);
+    }
+    const int64_t per_job = std::max(threads_per_window, 1) * stack_bytes +
+                            std::max<int64_t>(pixels, 1) * kWindowBytesPerPixel;
+    lower(address_space_bytes / 2 / per_job,
+          "the address space limit (ulimit -v, " + std::to_string(address_space_bytes >> 20) +
+              " MiB) leaves room for that many windows' stacks and working memory");
+  }
+  if (windows > 0)
+    lower(windows, "there are only " + std::to_string(windows) + " windows to solve");
+  return capped;
+}
+
 VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                      const std::string& staging) {
   const auto total_start = Clock::now();
@@ -554,6 +594,8 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   VideoResult result;
   result.width = data.width();
   result.height = data.height();
+  // From the declared size, before a frame is decoded (each window needs two latent frames).
+  CheckSensorFitsLatentVoxels(result.width, result.height, request.binning);
   VideoWindowOptions window_options = request.windows;
   if (request.skip_bad_frames) {
     const int last = window_options.last >= 0
@@ -672,7 +714,19 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   }
 
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  result.jobs = request.jobs > 0 ? request.jobs : cores;
+  const int threads_per_window =
+      request.threads_per_window > 0
+          ? request.threads_per_window
+          : std::max(1, cores / std::max(1, request.jobs > 0 ? request.jobs : cores));
+  std::string capped_because;
+  result.jobs =
+      CapVideoJobs(request.jobs > 0 ? request.jobs : cores, static_cast<int>(pending.size()), cores,
+                   threads_per_window, static_cast<int64_t>(result.width) * result.height,
+                   AddressSpaceLimit(), &capped_because);
+  if (request.jobs > 0 && result.jobs < request.jobs && request.notice) {
+    request.notice("--jobs=" + std::to_string(request.jobs) + " lowered to " +
+                   std::to_string(result.jobs) + ": " + capped_because);
+  }
   result.threads_per_window = request.threads_per_window > 0 ? request.threads_per_window
                                                              : std::max(1, cores / result.jobs);
   WindowContext context;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -22,7 +23,16 @@ void ParallelForEach(int count, int workers, const std::function<void(int)>& tas
     }
   };
   std::vector<std::thread> threads;
-  for (int w = 1; w < std::min(std::max(workers, 1), count); ++w) threads.emplace_back(work);
+  for (int w = 1; w < std::min(std::max(workers, 1), count); ++w) {
+    // A thread that cannot start (its stack is address space an RLIMIT_AS may not leave, or
+    // the process ran into its thread limit) leaves its tasks to the threads that did: the
+    // result is the same, only later.
+    try {
+      threads.emplace_back(work);
+    } catch (const std::system_error&) {
+      break;
+    }
+  }
   work();
   for (std::thread& thread : threads) thread.join();
   for (const std::exception_ptr& error : errors) {

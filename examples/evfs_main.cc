@@ -24,8 +24,10 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <new>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "app/allocator_tuning.h"
@@ -652,6 +654,9 @@ int RunVideoCommand(ProgressReporter* progress) {
   request.method = reconstruct.method;
   request.denoise = reconstruct.denoise;
   request.settings = VideoSettings();
+  request.notice = [](const std::string& line) {
+    std::fprintf(stderr, "evfs video: %s\n", line.c_str());
+  };
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
   // Under mpirun: rank 0 writes, the other ranks solve the windows it hands out.
@@ -892,6 +897,18 @@ int main(int argc, char** argv) {
     } catch (const evfs::Error& error) {
       std::fprintf(stderr, "evfs %s: %s\n", command.c_str(), error.what());
       return 2;
+    } catch (const std::bad_alloc&) {
+      // Memory beyond what the machine (or ulimit -v) gives, past every limit checked from
+      // the declared sizes: one line and kExitUnexpected (core/error.h).
+      std::fprintf(stderr,
+                   "evfs %s: out of memory (a smaller window, --fps, --jobs or input, or more "
+                   "memory)\n",
+                   command.c_str());
+      return static_cast<int>(evfs::kExitUnexpected);
+    } catch (const std::system_error& error) {
+      std::fprintf(stderr, "evfs %s: the system refused a resource: %s\n", command.c_str(),
+                   error.what());
+      return static_cast<int>(evfs::kExitUnexpected);
     } catch (const std::exception& error) {
       std::fprintf(stderr, "evfs %s: unexpected error: %s\n", command.c_str(), error.what());
       return 1;

@@ -64,6 +64,22 @@ std::string DefaultFramePath(size_t index) {
   return name;
 }
 
+// The sensor's size from the first frame's header, so that the limits on it (max_latent_voxels)
+// are checked before a frame of that size is decoded; decoded when the header does not say or
+// declares more than a frame may have (ReadGreyImage's error names the file).
+void FirstFrameSize(const std::string& path, int* width, int* height) {
+  int64_t header_width = 0, header_height = 0;
+  if (ReadImageHeaderSize(path, &header_width, &header_height) && header_width > 0 &&
+      header_height > 0 && header_width * header_height <= kMaxSensorPixels) {
+    *width = static_cast<int>(header_width);
+    *height = static_cast<int>(header_height);
+    return;
+  }
+  const Image first = ReadGreyImage(path);
+  *width = static_cast<int>(first.cols());
+  *height = static_cast<int>(first.rows());
+}
+
 }  // namespace
 
 TextFolderDataSource::TextFolderDataSource(const std::string& folder)
@@ -85,15 +101,11 @@ TextFolderDataSource::TextFolderDataSource(const std::string& folder, std::vecto
       throw InputError(InputError::Kind::kMissingFile, events_txt, 0,
                        "does not exist, and " + no_frames_reason_ + ": not a data folder");
     }
-    const Image first = ReadGreyImage((fs::path(folder) / frames_.front().path).string());
-    width_ = static_cast<int>(first.cols());
-    height_ = static_cast<int>(first.rows());
+    FirstFrameSize((fs::path(folder) / frames_.front().path).string(), &width_, &height_);
     return;
   }
   if (!frames_.empty()) {
-    const Image first = ReadGreyImage((fs::path(folder) / frames_.front().path).string());
-    width_ = static_cast<int>(first.cols());
-    height_ = static_cast<int>(first.rows());
+    FirstFrameSize((fs::path(folder) / frames_.front().path).string(), &width_, &height_);
   } else {
     const EventSummary summary = EventTextReader(events_txt).Summarize();
     width_ = summary.max_x + 1;

@@ -227,6 +227,21 @@ bool BinningOptions::IsValid(std::string* error) const {
   return check.Passed(error);
 }
 
+void CheckSensorFitsLatentVoxels(int width, int height, const BinningOptions& binning) {
+  const int64_t pixels = static_cast<int64_t>(std::max(width, 0)) * std::max(height, 0);
+  if (pixels == 0) return;
+  const int64_t fewest_latent_frames =
+      binning.method == BinningOptions::Method::kStacked
+          ? static_cast<int64_t>(binning.stacked.num_frames) * binning.stacked.steps_per_frame + 1
+          : 2;
+  if (fewest_latent_frames > binning.max_latent_voxels / pixels) {
+    throw InvalidArgumentError(
+        "the " + std::to_string(width) + "x" + std::to_string(height) + " sensor needs at least " +
+        VoxelCount(fewest_latent_frames, pixels) +
+        ", more than max_latent_voxels = " + std::to_string(binning.max_latent_voxels));
+  }
+}
+
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
                         const BinningOptions& binning, const std::vector<const Image*>& frames) {
   EventStream kept;

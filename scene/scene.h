@@ -127,6 +127,12 @@ struct BinningPlan {
 /// change, when the binning asked for would exceed binning.max_latent_voxels (explicit collision or
 /// stacked binning over it, or a sensor on which not even one latent step fits), for invalid
 /// options, for a frame of another size than the sensor, or as the binning functions do.
+/// Throws InvalidArgumentError, naming max_latent_voxels, when a width × height sensor cannot
+/// fit the fewest latent frames `binning` allows (two; stacked binning: its frames × steps + 1)
+/// within binning.max_latent_voxels. PlanBinning checks the same from the events; this check
+/// needs only the declared sizes, so readers call it before decoding a frame.
+void CheckSensorFitsLatentVoxels(int width, int height, const BinningOptions& binning);
+
 BinningPlan PlanBinning(const EventStream& events, int64_t window_begin_ns, int64_t window_end_ns,
                         const BinningOptions& binning,
                         const std::vector<const Image*>& frames = {});

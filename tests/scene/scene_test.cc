@@ -41,6 +41,21 @@ void ExpectRefused(const Call& call) {
   }
 }
 
+TEST(CheckSensorFitsLatentVoxels, RefusesADeclaredSizeBeforeAnyFrame) {
+  BinningOptions binning;
+  // An 8192x8192 sensor (an HDF5 file may declare it over two small compressed frames): two
+  // latent frames are 134 M voxels, over the default cap; nothing of that size is allocated.
+  ExpectRefused([&] { CheckSensorFitsLatentVoxels(8192, 8192, binning); });
+  CheckSensorFitsLatentVoxels(346, 260, binning);
+  binning.method = BinningOptions::Method::kStacked;
+  binning.stacked.num_frames = 20;
+  binning.stacked.steps_per_frame = 1;
+  binning.max_latent_voxels = 346 * 260 * 21;
+  CheckSensorFitsLatentVoxels(346, 260, binning);
+  binning.max_latent_voxels -= 1;
+  ExpectRefused([&] { CheckSensorFitsLatentVoxels(346, 260, binning); });
+}
+
 // `events` plus `count` events at (x, y), alternating in polarity, spread over [begin, end).
 EventStream WithHotPixel(const EventStream& events, int x, int y, int count, int64_t begin_ns,
                          int64_t end_ns) {
