@@ -287,6 +287,53 @@ std::vector<uint8_t> FramesTheOutputNeeds(const VideoWindow& window, const Scene
   return context.request->denoise.consistency ? FramesToDenoise(scene, read) : read;
 }
 
+// A fingerprint of what a window read: its observed frames' pixels and its events, FNV-1a over
+// their bytes. --resume reuses a window only when the recording still gives it the same input;
+// this notices a changed recording, it is no defence against a made-up collision.
+class WindowInputHash {
+ public:
+  void Add(const void* bytes, size_t size) {
+    const auto* byte = static_cast<const unsigned char*>(bytes);
+    for (size_t i = 0; i < size; ++i) hash_ = (hash_ ^ byte[i]) * kPrime;
+  }
+  template <typename T>
+  void AddAll(const std::vector<T>& values) {
+    const uint64_t count = values.size();
+    Add(&count, sizeof(count));
+    if (!values.empty()) Add(values.data(), values.size() * sizeof(T));
+  }
+  void AddImage(const Image& image) {
+    const int64_t size[2] = {image.rows(), image.cols()};
+    Add(size, sizeof(size));
+    Add(image.data(), static_cast<size_t>(image.size()) * sizeof(double));
+  }
+  void AddEvents(const EventStream& events) {
+    AddAll(events.t_ns());
+    AddAll(events.x());
+    AddAll(events.y());
+    AddAll(events.polarity());
+  }
+  std::string Hex() const {
+    char text[17];
+    std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash_));
+    return text;
+  }
+
+ private:
+  static constexpr uint64_t kPrime = 1099511628211ull;
+  uint64_t hash_ = 14695981039346656037ull;
+};
+
+// The fingerprint of what `window` reads from the recording now.
+std::string ReadWindowInputHash(const VideoWindow& window, const SharedSource& source) {
+  WindowInputHash hash;
+  for (const VideoWindowFrame& observed : window.frames) {
+    hash.AddImage(source.ReadImage(observed.index));
+  }
+  hash.AddEvents(source.ReadEvents(window.begin_ns, window.end_ns));
+  return hash.Hex();
+}
+
 // Solves one window, writes the output frames it owns into the work folder and returns its
 // record (written last).
 Json RunWindow(const VideoWindow& window, const WindowContext& context) {
@@ -302,6 +349,9 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     frames.push_back(std::move(frame));
   }
   const EventStream events = context.source->ReadEvents(window.begin_ns, window.end_ns);
+  WindowInputHash input_hash;
+  for (const TimedFrame& frame : frames) input_hash.AddImage(frame.image);
+  input_hash.AddEvents(events);
   const double read_s = SecondsSince(start);
 
   const auto bin_start = Clock::now();
@@ -375,6 +425,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["t_end_s"] = NanosecondsToSeconds(window.end_ns);
   record["output_frames"] = {begin, end};
   record["events"] = scene.num_events;
+  record["input_hash"] = input_hash.Hex();
   record["hot_pixels"] = scene.hot_pixels.size();
   record["saturated_pixels"] = scene.saturated_pixels.size();
   record["flickering_pixels"] = scene.flickering_pixels.size();
@@ -707,6 +758,23 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
     }
     it = complete ? std::next(it) : records.erase(it);
   }
+  // A recorded window is reused only when the recording still gives it the same frames and
+  // events: the settings' fingerprint above does not see a recording edited in place. Each
+  // window's input is read again (no solve), which costs a small part of solving it.
+  const int windows_recorded = static_cast<int>(records.size());
+  for (auto it = records.begin(); it != records.end();) {
+    const bool same = it->second.contains("input_hash") && it->second["input_hash"].is_string() &&
+                      it->second["input_hash"].get<std::string>() ==
+                          ReadWindowInputHash(windows[it->first], source);
+    if (!same) ++result.windows_changed;
+    it = same ? std::next(it) : records.erase(it);
+  }
+  if (result.windows_changed > 0) {
+    std::fprintf(stderr,
+                 "evfs: --resume: the recording changed since the interrupted run: recomputing "
+                 "%d of the %d windows it had finished\n",
+                 result.windows_changed, windows_recorded);
+  }
   result.windows_resumed = static_cast<int>(records.size());
   std::vector<int> pending;
   for (const VideoWindow& window : windows) {
@@ -912,6 +980,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   summary["run"] = {{"jobs", result.jobs},
                     {"threads_per_window", result.threads_per_window},
                     {"windows_resumed", result.windows_resumed},
+                    {"windows_changed", result.windows_changed},
                     {"solve_wall_s", Number(result.solve_wall_s)},
                     {"total_wall_s", Number(result.total_wall_s)},
                     {"windows_per_s", Number(result.windows_per_s)},

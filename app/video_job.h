@@ -99,6 +99,9 @@ struct VideoResult {
   double fps = 0.0;
   int windows = 0;
   int windows_resumed = 0;
+  /// Windows the interrupted run had finished whose frames or events changed since (--resume):
+  /// solved again.
+  int windows_changed = 0;
   std::vector<int> skipped_frames;  // left out as unreadable (--skip_bad_frames)
   /// Frames whose exposure was tested (VideoWindowOptions::blur_from_data) and what was found.
   std::vector<std::pair<int, ExposureBlurEstimate>> exposure_tests;

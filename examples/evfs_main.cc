@@ -264,7 +264,8 @@ DEFINE_double(progress_interval_s, 5.0,
 DEFINE_int32(jobs, 0, "video: windows solved at once; 0: every core.");
 DEFINE_bool(resume, false,
             "video: reuse the windows an interrupted run of the same command finished (kept in "
-            ".OUT.evfs-video-work beside OUT).");
+            ".OUT.evfs-video-work beside OUT). A window whose frames or events changed in the "
+            "recording since is solved again, and stderr says how many.");
 DEFINE_bool(preview, false,
             "video: also preview.mp4, side by side: last observed frame | reconstruction | the "
             "step's events (red ON, blue OFF).");

@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <pwd.h>
 #include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -321,20 +323,30 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
                          " bytes, the system allows " + std::to_string(PATH_MAX) + ")");
   }
 
-  RemoveLeftovers();
-
   // Nothing has been read or computed yet: create the parents and the staging path now, so an
   // output that cannot be written fails before the work.
+  const auto remove_created_parents = [this] {
+    std::error_code ignored;
+    for (auto created = created_parents_.rbegin(); created != created_parents_.rend(); ++created) {
+      fs::remove(*created, ignored);  // only while empty
+    }
+  };
   for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
     if (!fs::create_directory(*it, error) || error) {
-      for (auto created = created_parents_.rbegin(); created != created_parents_.rend();
-           ++created) {
-        fs::remove(*created, error);
-      }
+      remove_created_parents();
       Unwritable(*it, "cannot create the folder (" + error.message() + ")");
     }
     created_parents_.push_back(it->string());
   }
+  // Taken before anything beside OUT is removed or created: the leftovers of another run are
+  // leftovers only when no run holds the lock.
+  try {
+    lock_ = std::make_unique<OutputLock>(path_);
+  } catch (...) {
+    remove_created_parents();
+    throw;
+  }
+  RemoveLeftovers();
   const bool is_file = options_.kind == OutputOptions::Kind::kFile;
   for (int attempt = 0;; ++attempt) {
     const fs::path staging = TaggedSibling(path, kStagingTag, is_file, attempt);
@@ -361,22 +373,82 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
     if (open_errno == EEXIST && attempt < 100) continue;  // a leftover of a killed run
     staging_.clear();
     const std::string reason = std::generic_category().message(open_errno);
-    for (auto created_parent = created_parents_.rbegin(); created_parent != created_parents_.rend();
-         ++created_parent) {
-      fs::remove(*created_parent, error);
-    }
+    lock_.reset();
+    remove_created_parents();
     Unwritable(path, "cannot create the output (" + reason + ")");
   }
 }
 
 OutputTarget::~OutputTarget() {
-  if (committed_ || staging_.empty()) return;
+  const bool remove = !committed_ && !staging_.empty();
   std::error_code error;
-  fs::remove_all(staging_, error);
-  cleanup_.reset();
+  if (remove) {
+    fs::remove_all(staging_, error);
+    cleanup_.reset();
+  }
+  lock_.reset();  // its file lies in the parents
+  if (!remove) return;
   for (auto it = created_parents_.rbegin(); it != created_parents_.rend(); ++it) {
     fs::remove(*it, error);  // only while empty
   }
+}
+
+std::string OutputLock::LockPath(const std::string& out_path) {
+  const fs::path path = Normalized(out_path);
+  return (path.parent_path() / ("." + path.filename().string() + ".evfs-lock")).string();
+}
+
+OutputLock::OutputLock(const std::string& out_path) : path_(LockPath(out_path)) {
+  // A holder removes the file as it lets go: a lock taken on a file that is no longer at
+  // path_ (or was replaced meanwhile) guards nothing, so it is taken again on the new file.
+  for (int attempt = 0;; ++attempt) {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd_ < 0) {
+      throw InputError(
+          InputError::Kind::kUnwritable, path_, 0,
+          std::string("cannot create the lock file of the output (") + std::strerror(errno) + ")");
+    }
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int flock_errno = errno;
+      char holder[32] = {0};
+      const ssize_t read_bytes = ::pread(fd_, holder, sizeof(holder) - 1, 0);
+      ::close(fd_);
+      fd_ = -1;
+      std::string pid = read_bytes > 0 ? std::string(holder, read_bytes) : "";
+      while (!pid.empty() && !std::isdigit(static_cast<unsigned char>(pid.back()))) pid.pop_back();
+      if (flock_errno != EWOULDBLOCK) {
+        throw InputError(
+            InputError::Kind::kUnwritable, path_, 0,
+            std::string("cannot lock the output (") + std::strerror(flock_errno) + ")");
+      }
+      throw InvalidArgumentError("--out=" + Normalized(out_path).string() +
+                                 " is being written by another evfs run" +
+                                 (pid.empty() ? std::string() : " (process " + pid + ")") +
+                                 "; wait for it to end, or choose another --out");
+    }
+    struct stat held = {}, named = {};
+    if (::fstat(fd_, &held) == 0 && ::lstat(path_.c_str(), &named) == 0 &&
+        held.st_dev == named.st_dev && held.st_ino == named.st_ino) {
+      break;
+    }
+    ::close(fd_);
+    fd_ = -1;
+    if (attempt >= 100) {
+      throw InputError(InputError::Kind::kUnwritable, path_, 0,
+                       "cannot lock the output: its lock file keeps changing");
+    }
+  }
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
+    // The process id only makes a refusal clearer; the lock holds without it.
+  }
+}
+
+OutputLock::~OutputLock() {
+  if (fd_ < 0) return;
+  // Removed while still held, so that no other run can hold a lock on a file about to go.
+  ::unlink(path_.c_str());
+  ::close(fd_);
 }
 
 void OutputTarget::CheckExisting() const {

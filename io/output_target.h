@@ -60,9 +60,38 @@ struct OutputOptions {
   std::function<void(const std::string& message)> warn;
 };
 
+/// An exclusive lock on one --out path, so that two evfs runs never write the same output (nor
+/// the work folder beside it) at once. It is flock(2) on the file .NAME.evfs-lock beside the
+/// output, which holds the holder's process id: the kernel releases it when the process ends in
+/// any way (SIGKILL included), so a lock file left by a killed run never blocks; the holder
+/// removes the file when it lets go. The lock file lies beside OUT, never inside it, so it is no
+/// part of an output.
+class OutputLock {
+ public:
+  /// Takes the lock on `out_path` without waiting: throws InvalidArgumentError, naming the output
+  /// and the holder's process id, when another process holds it, and InputError(kUnwritable)
+  /// when the lock file cannot be created. The folder holding `out_path` must exist.
+  explicit OutputLock(const std::string& out_path);
+  /// Removes the lock file and releases the lock.
+  ~OutputLock();
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+
+  /// The lock file's path.
+  const std::string& path() const { return path_; }
+
+  /// The lock file of `out_path`: .NAME.evfs-lock in the same folder.
+  static std::string LockPath(const std::string& out_path);
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
 class OutputTarget {
  public:
-  /// Checks `options.path` and creates the staging folder (kFolder) or an empty staging file
+  /// Checks `options.path`, takes its OutputLock (a second run on the same --out is refused
+  /// while the first runs) and creates the staging folder (kFolder) or an empty staging file
   /// (kFile) beside it, creating missing parent folders. Throws InvalidArgumentError for a path
   /// evfs must not write (naming the reason) and InputError(kUnwritable) when it cannot.
   explicit OutputTarget(OutputOptions options);
@@ -98,6 +127,7 @@ class OutputTarget {
   std::string staging_;
   std::vector<std::string> created_parents_;  // deepest last
   std::unique_ptr<ScopedCleanupPath> cleanup_;
+  std::unique_ptr<OutputLock> lock_;  // held from the checks until this object ends
   bool committed_ = false;
 };
 

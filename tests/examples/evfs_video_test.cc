@@ -191,6 +191,72 @@ TEST(EvfsVideo, AnInterruptedRunResumesIntoTheSameOutput) {
   EXPECT_FALSE(fs::exists(work));
 }
 
+// The recording is edited in place (polarities flipped in its first third) between the
+// interrupted run and --resume: the finished windows that read changed events are solved again,
+// said on stderr, and the output is that of a fresh run on the edited recording.
+TEST(EvfsVideo, ResumeRecomputesTheWindowsWhoseRecordingChanged) {
+  const fs::path root = test::ScratchDir("video_resume_changed");
+  const std::string data = WriteSyntheticFolder(root.string(), 31, 4, 64, 48);
+  const std::vector<std::string> arguments = {"video", "--data=" + data, "--fps=500", "--jobs=1",
+                                              "--threads=1"};
+  const fs::path out = root / "out";
+  std::vector<std::string> interrupted = arguments;
+  interrupted.push_back("--out=" + out.string());
+  const pid_t pid = StartEvfs(interrupted, root);
+  ASSERT_GT(pid, 0);
+  const fs::path work = root / ".out.evfs-video-work";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(work / "windows" / "000002.json") &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(fs::exists(work / "windows" / "000002.json")) << "no window finished";
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before the signal: make it longer";
+
+  // The stale frames: those the interrupted run wrote from the recording as it was.
+  std::vector<std::pair<fs::path, std::string>> stale;
+  for (const auto& entry : fs::directory_iterator(work / "frames")) {
+    if (entry.path().extension() == ".png" && entry.path().stem().extension().empty()) {
+      stale.emplace_back(entry.path().filename(), ReadFile(entry.path()));
+    }
+  }
+  const fs::path events_path = fs::path(data) / "events.txt";
+  const std::vector<std::string> lines = Lines(ReadFile(events_path));
+  std::string edited;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::string line = lines[i];
+    if (i < lines.size() / 3 && !line.empty()) {
+      char& polarity = line.back();
+      polarity = polarity == '1' ? '0' : '1';
+      if (line.size() >= 2 && line[line.size() - 2] == '-') line.erase(line.size() - 2, 1);
+    }
+    edited += line + "\n";
+  }
+  test::WriteFile(events_path.string(), edited);
+
+  const CommandResult resumed = RunEvfs("video --data=" + data + " --out=" + out.string() +
+                                        " --fps=500 --jobs=1 --threads=1 --resume");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.errors.find("the recording changed since the interrupted run"),
+            std::string::npos)
+      << resumed.errors;
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_GE(summary["run"]["windows_changed"].get<int>(), 1);
+
+  const CommandResult fresh =
+      RunEvfs("video --data=" + data + " --out=" + (root / "fresh").string() +
+              " --fps=500 --jobs=1 --threads=1");
+  ASSERT_EQ(fresh.exit_code, 0) << fresh.output;
+  ExpectSameFrames(root / "fresh", out);
+  int changed_frames = 0;
+  for (const auto& [name, bytes] : stale)
+    changed_frames += ReadFile(out / "frames" / name) != bytes;
+  EXPECT_GT(changed_frames, 0);
+}
+
 #ifdef EVFS_MPIRUN
 // mpirun -np 2: rank 0 hands the windows to rank 1 and writes; the frames are those of one
 // process.

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -458,8 +459,89 @@ void ExpectSignalCleansUp(int signal_number) {
   const std::vector<std::string> removed = channel.RemoveLeftovers();
   EXPECT_EQ(removed, std::vector<std::string>{staging.string()});
   EXPECT_FALSE(fs::exists(staging));
-  EXPECT_EQ(sandbox.Others(sandbox.root, "out").size(), 4u) << "a staging folder was left";
+  // The killed run's lock file may stay (the next run on OUT takes it and removes it): only
+  // the kernel's lock, gone with the process, guards the output.
+  std::vector<std::string> others = sandbox.Others(sandbox.root, "out");
+  others.erase(std::remove(others.begin(), others.end(), ".out.evfs-lock"), others.end());
+  EXPECT_EQ(others.size(), 4u) << "a staging folder was left";
   EXPECT_EQ(test::ReadFile((out / "old.txt").string()), "old.txt");
+}
+
+// A second run on the same --out is refused, naming the output and the first run's process,
+// for as long as the first holds the lock; a SIGKILL of the holder releases it.
+TEST(OutputLockTest, ASecondRunIsRefusedWhileTheFirstHoldsTheLock) {
+  const Sandbox sandbox("lock");
+  const fs::path out = sandbox.root / "out";
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t holder = ::fork();
+  ASSERT_GE(holder, 0);
+  if (holder == 0) {
+    ::close(ready[0]);
+    OutputTarget target(sandbox.Options(out));
+    const char byte = 1;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(1);
+    ::pause();  // until killed
+    ::_exit(0);
+  }
+  ::close(ready[1]);
+  char byte = 0;
+  ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+  ::close(ready[0]);
+
+  const std::string holder_pid = std::to_string(holder);
+  for (const bool direct : {true, false}) {
+    try {
+      if (direct) {
+        OutputLock lock(out.string());
+      } else {
+        OutputTarget target(sandbox.Options(out));
+      }
+      ADD_FAILURE() << "a second run took the lock";
+    } catch (const InvalidArgumentError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find(out.string()), std::string::npos) << message;
+      EXPECT_NE(message.find("process " + holder_pid), std::string::npos) << message;
+    }
+  }
+  // The holder's staging folder is not a leftover while it runs.
+  bool staging_kept = false;
+  for (const std::string& name : sandbox.Others(sandbox.root, "out")) {
+    staging_kept |= name.rfind(".out.evfs-tmp-" + holder_pid, 0) == 0;
+  }
+  EXPECT_TRUE(staging_kept);
+
+  ::kill(holder, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(::waitpid(holder, &status, 0), holder);
+  // The killed run's lock file is still there, and does not block.
+  EXPECT_TRUE(fs::exists(OutputLock::LockPath(out.string())));
+  {
+    OutputTarget target(sandbox.Options(out));
+    target.Commit();
+  }
+  EXPECT_TRUE(fs::exists(out / kOutputMarkerFile));
+  EXPECT_FALSE(fs::exists(OutputLock::LockPath(out.string())));
+}
+
+// The lock file lies beside OUT: an output that exists is replaced with --overwrite while
+// its own run's lock file is there, and nothing of the lock is inside the output.
+TEST(OutputLockTest, TheLockFileIsNoPartOfTheOutput) {
+  const Sandbox sandbox("lock_overwrite");
+  const fs::path out = sandbox.root / "out";
+  {
+    OutputTarget target(sandbox.Options(out));
+    EXPECT_TRUE(fs::exists(OutputLock::LockPath(out.string())));
+    target.Commit();
+  }
+  OutputOptions options = sandbox.Options(out);
+  options.overwrite = true;
+  {
+    OutputTarget target(options);
+    target.Commit();
+  }
+  EXPECT_EQ(sandbox.Others(sandbox.root, "out").size(), 4u);  // root, home, cwd, data
+  EXPECT_EQ(sandbox.Others(out, "").size(), 1u);              // the marker
 }
 
 TEST(SignalCleanupTest, AReleasedPathIsNotRemoved) {
