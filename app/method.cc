@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
+#include "io/text_folder.h"
 #include "scene/activity_mask.h"
 #include "scene/scene.h"
 
@@ -167,6 +168,10 @@ void CheckResampledOutputFits(double fps, double span_s, int width, int height,
                 kMaxResampledOutputBytes / 1e6,
                 span_s > 0.0 ? std::floor(std::max(most_frames - 1.0, 1.0) / span_s) : 0.0);
   throw InvalidArgumentError(message);
+}
+
+void CheckWholeTextRecording(const DataSource& source) {
+  if (dynamic_cast<const TextFolderDataSource*>(&source) != nullptr) source.Summarize();
 }
 
 void StartSolveClock(MethodOptions* options) {

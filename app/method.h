@@ -18,6 +18,7 @@
 #include "baselines/baseline_options.h"
 #include "core/enum_names.h"
 #include "core/video.h"
+#include "io/data_source.h"
 #include "scene/confidence.h"
 #include "scene/scene.h"
 #include "solver/first_order_solvers.h"
@@ -90,6 +91,12 @@ inline constexpr double kMaxResampledOutputBytes = 512.0 * (1 << 20);
 /// would hold more than kMaxResampledOutputBytes.
 void CheckResampledOutputFits(double fps, double span_s, int width, int height,
                               const std::string& what);
+
+/// A text recording (events.txt) is parsed whole once, as `evfs info` parses it, so that every
+/// command accepts and refuses the same files, whichever window it reads; the binary formats
+/// (HDF5, AEDAT) check their structure when they open and each part as it is read. Throws the
+/// reader's InputError.
+void CheckWholeTextRecording(const DataSource& source);
 
 /// Starts the clock of one command's (or one video window's) solve: sets
 /// options->reconstruction.stop to end every solve stage that follows — the method, plug & play

@@ -147,6 +147,7 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   std::unique_ptr<DataSource> opened;
   if (given == nullptr) opened = DataSource::Open(request.data_path);
   const DataSource* source = given != nullptr ? given : opened.get();
+  CheckWholeTextRecording(*source);
   result.width = source->width();
   result.height = source->height();
   // From the declared size, before a frame is decoded: a large declared sensor with small

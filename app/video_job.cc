@@ -640,6 +640,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   // Loaded before any input is read: a bad weights file fails in milliseconds.
   const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request.denoise);
   const SharedSource source(request.data_path);
+  CheckWholeTextRecording(source.unlocked());
   const DataSource& data = source.unlocked();
 
   VideoResult result;

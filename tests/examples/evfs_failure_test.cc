@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -121,6 +122,26 @@ TEST(EvfsFailure, BadSolverAndFrameFlagsNameTheFlag) {
   const CommandResult slow = RunEvfs(video + " --fps=1e-3");
   ExpectUserError(slow, "--fps must be 0 (derived) or at least 1 frame per second", out);
   EXPECT_EQ(slow.output.find("windows"), std::string::npos) << "solved first: " << slow.output;
+}
+
+// Only a window's events are read to solve it, but a text recording is parsed whole once by every
+// command, so that info, reconstruct and video accept and refuse the same events.txt.
+TEST(EvfsFailure, MalformedEventLineOutsideTheWindowIsRefusedByEveryCommand) {
+  const fs::path scratch = test::ScratchDir("failure_line_outside_window");
+  const fs::path out = scratch / "out";
+  const fs::path data = WriteSyntheticFolder(scratch.string());
+  std::ofstream(data / "events.txt", std::ios::app) << "1.5 3 4 x\n";  // after every frame
+  const std::string expected = (data / "events.txt").string() + ":";
+  for (const std::string& command :
+       {"info --data=" + data.string(),
+        "reconstruct --data=" + data.string() +
+            " --mode=interpolate --first=0 --last=1 --out=" + out.string(),
+        "video --data=" + data.string() + " --out=" + out.string()}) {
+    const CommandResult result = RunEvfs(command);
+    ExpectUserError(result, expected, out);
+    EXPECT_NE(result.errors.find("field 'p'"), std::string::npos)
+        << command << ": " << result.errors;
+  }
 }
 
 // events.txt or images.txt that exists but is no regular file used to read as "this folder
