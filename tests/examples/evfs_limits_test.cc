@@ -214,6 +214,38 @@ TEST(EvfsLimits, TinyFpsGivesOneFrame) {
       "--fps", scratch + "/out");
 }
 
+// --max_time_s bounds the whole solve: a schedule of a million Adam steps ends near the budget
+// with the answer it has, and the solve line and summary.json say why (Levenberg-Marquardt and
+// L-BFGS converge on this small scene first; tests/solver holds them to a deadline). The budget
+// is 1 s and the test fails only when the run reaches the 120 s limit: no timing noise decides.
+TEST(EvfsLimits, MaxTimeBoundsEveryIterativeSolve) {
+  const std::string scratch = test::ScratchDir("limits_max_time");
+  const std::string data = WriteSyntheticFolder(scratch);
+  for (const std::string solver : {"adam", "adam_smooth"}) {
+    SCOPED_TRACE(solver);
+    const std::string out = scratch + "/out_" + solver;
+    const CommandResult run = RunLimited(
+        "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=4 --solver=" + solver +
+        " --adam_iterations=1000000 --max_iterations=1000000 --function_tolerance=0 " +
+        "--max_time_s=1 --out=" + out);
+    ASSERT_NE(run.exit_code, kTimedOut) << "the budget was ignored";
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("stopped early (time limit --max_time_s reached)"), std::string::npos)
+        << run.output;
+    EXPECT_NE(ReadFile(out + "/summary.json").find("\"stopped_early\""), std::string::npos);
+  }
+}
+
+// --jobs beyond the windows is lowered, and said so, rather than starting idle threads.
+TEST(EvfsLimits, VideoJobsBeyondTheWindowsAreLowered) {
+  const std::string scratch = test::ScratchDir("limits_jobs");
+  const std::string data = WriteSyntheticFolder(scratch);
+  const CommandResult run =
+      RunLimited("video --data=" + data + " --jobs=4096 --fps=400 --out=" + scratch + "/out");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.errors.find("--jobs=4096 lowered to"), std::string::npos) << run.errors;
+}
+
 // Regression: --activity_radius_px of 2^31 - 239 or more overflowed int in the
 // dilation of the activity mask (SIGSEGV). Any radius beyond the sensor solves every pixel.
 TEST(EvfsLimits, HugeActivityRadiusSolvesEveryPixel) {
