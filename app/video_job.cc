@@ -310,7 +310,13 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
                                " cannot reconstruct window " + std::to_string(window.index) + ": " +
                                why_not);
   }
-  MethodResult run = RunMethod(scene, context.method, IterationCallback(), false, nullptr);
+  IterationCallback keep_going;
+  if (request.cancelled) {
+    keep_going = [&request](const SolverIteration&) { return !request.cancelled(); };
+  }
+  MethodResult run = RunMethod(scene, context.method, keep_going, false, nullptr);
+  // A solve the caller stopped is unfinished: it must not be recorded for resume.
+  if (request.cancelled && request.cancelled()) throw Interrupted();
   int64_t begin = 0, end = 0;
   context.clock->FramesOf(window, &begin, &end);
   double denoise_s = 0.0;
@@ -681,9 +687,16 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   std::mutex take_mutex;
   size_t next_pending = 0;
   int solved = 0;
+  const auto stop_requested = [&request] { return request.cancelled && request.cancelled(); };
+  const auto stop_if_requested = [&] {
+    if (!stop_requested()) return;
+    remove_on_error.armed = false;
+    throw Interrupted();
+  };
   const auto take = [&]() -> int {
     const std::lock_guard<std::mutex> lock(take_mutex);
     if (failed) return -1;  // an earlier window failed: the run ends with its error
+    if (stop_requested()) return -1;
     if (worker) return distribution->next();
     return next_pending < pending.size() ? pending[next_pending++] : -1;
   };
@@ -708,6 +721,9 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
           progress.elapsed_s = SecondsSince(solve_start);
           records[index] = std::move(record);
           if (request.progress) request.progress(progress);
+        } catch (const Interrupted&) {
+          // Not a failure of the run: the work folder stays for resume (checked below).
+          failed = true;
         } catch (...) {
           failed = true;
           throw;
@@ -715,6 +731,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
       }
     });
   }
+  stop_if_requested();
   result.solve_wall_s = SecondsSince(solve_start);
   result.windows_per_s = result.solve_wall_s > 0.0 ? solved / result.solve_wall_s : 0.0;
   result.events_per_s =
@@ -730,6 +747,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   fs::create_directories(out / "confidence");
   std::vector<int64_t> times;
   for (int64_t n = 0; n < result.output_frames; ++n) {
+    stop_if_requested();
     for (const char* folder : {"frames", "confidence"}) {
       LinkFrame(work / folder / (FrameName(n) + ".png"), out / folder / (FrameName(n) + ".png"));
     }
@@ -739,6 +757,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   {
     Mp4Writer video((out / "video.mp4").string(), fps, result.width, result.height);
     for (int64_t n = 0; n < result.output_frames; ++n) {
+      stop_if_requested();
       video.WriteGrey(ReadGreyImage((work / "frames" / (FrameName(n) + ".png")).string()));
     }
     video.Close();

@@ -83,6 +83,12 @@ struct VideoRequest {
   std::string settings;
   /// Called after each window, from the worker threads, one call at a time; may be empty.
   std::function<void(const VideoProgress&)> progress;
+  /// Asked, from any thread, whether the caller wants the run to stop; may be empty (the CLI
+  /// stops by a signal instead, app/crash_guard.h). Once it answers true, the solves in flight
+  /// end at their next iteration, no window is recorded as done from a stopped solve, and
+  /// RunVideo throws Interrupted. The work folder is kept, as a signal keeps it, so that
+  /// `resume` reuses the windows finished before.
+  std::function<bool()> cancelled;
   /// Windows shared with other processes; null: every window in this one. A worker returns
   /// after its windows, writing nothing into `staging`.
   const VideoDistribution* distribution = nullptr;

@@ -41,6 +41,13 @@ class SolverError : public Error {
   explicit SolverError(const std::string& message) : Error(message) {}
 };
 
+/// The caller asked a running job to stop (the Python module when Ctrl-C arrives): the job
+/// ends at its next check, and nothing it was making is kept as if complete.
+class Interrupted : public Error {
+ public:
+  Interrupted() : Error("interrupted") {}
+};
+
 /// A value given by the user (an option, a flag, an index) is outside what is accepted.
 class InvalidArgumentError : public Error {
  public:

@@ -16,12 +16,22 @@
 
 namespace evfs {
 
+/// Largest side of the frames: event coordinates are uint16. Their area is bounded further by
+/// kMaxSensorPixels (io/image_io.h), as for every recording evfs reads.
+inline constexpr int kMaxSensorSide = 65536;
+
 /// Borrowed arrays of a recording. Every pointer must stay valid, and its data unchanged, for
 /// the lifetime of the ArraySource made from it.
 struct RecordingArrays {
-  /// num_frames × height × width intensities in [0, 1], C order; exactly one of the two is set.
-  const float* frames_float32 = nullptr;
-  const double* frames_float64 = nullptr;
+  /// num_frames × height × width intensities in [0, 1], float32 or float64 (frames_float32),
+  /// element [f, r, c] at frames_data + f * frame_stride + r * row_stride + c * column_stride
+  /// bytes. Strides may be negative or zero and elements unaligned: a NumPy view is read where
+  /// it lies, so that no layout (a broadcast view of a huge array included) costs a copy.
+  const char* frames_data = nullptr;
+  bool frames_float32 = false;
+  int64_t frame_stride = 0;
+  int64_t row_stride = 0;
+  int64_t column_stride = 0;
   int num_frames = 0;
   int height = 0;
   int width = 0;

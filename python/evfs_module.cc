@@ -2,16 +2,23 @@
 // event simulator run on NumPy arrays, through the same application library as the command
 // line (app/). Errors that are the user's become ValueError with the command line's one-line
 // message, a failed solve RuntimeError. The GIL is released while evfs reads, solves and
-// simulates.
+// simulates, and Ctrl-C stops each of these within a solver iteration (RunInterruptibly).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -24,6 +31,7 @@
 #include "core/video.h"
 #include "events/simulator.h"
 #include "io/data_source.h"
+#include "io/image_io.h"
 #include "io/output_target.h"
 #include "python/array_source.h"
 #include "python/reconstruct_options.h"
@@ -42,12 +50,11 @@ std::string TypeName(py::handle object) {
 
 std::string DtypeName(const py::array& array) { return py::str(array.dtype()); }
 
-// `object` as a NumPy array of exactly dtype T with `ndim` dimensions, C-contiguous: the array
-// itself when it is one (no copy), a contiguous copy when only the layout differs. Any other
-// dtype is refused rather than converted, so that no value is silently changed.
+// Whether `object` is a NumPy array of exactly dtype T with `ndim` dimensions; throws
+// InvalidArgumentError naming `name` otherwise. Any other dtype (a byte-swapped one included) is
+// refused rather than converted, so that no value is silently changed.
 template <typename T>
-py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
-                                                const std::string& name) {
+py::array CheckedDtypeAndRank(py::handle object, int ndim, const std::string& name) {
   const std::string expected =
       std::to_string(ndim) + "-D " + std::string(py::str(py::dtype::of<T>()));
   if (!py::isinstance<py::array>(object)) {
@@ -64,7 +71,20 @@ py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
     throw InvalidArgumentError(name + " must be a " + expected + " array, not " +
                                std::to_string(array.ndim()) + "-D");
   }
-  return py::array_t<T, py::array::c_style>::ensure(array);
+  return array;
+}
+
+// `object` as a C-contiguous, aligned NumPy array of exactly dtype T with `ndim` dimensions:
+// the array itself when it is one, else a copy (numpy.require). A copy that cannot be made
+// raises NumPy's MemoryError; pybind11's array_t::ensure would return an empty handle instead,
+// and reading through it would crash the interpreter.
+template <typename T>
+py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
+                                                const std::string& name) {
+  const py::array array = CheckedDtypeAndRank<T>(object, ndim, name);
+  const py::object required = py::module_::import("numpy").attr("require")(
+      array, py::dtype::of<T>(), py::make_tuple("C_CONTIGUOUS", "ALIGNED"));
+  return py::reinterpret_borrow<py::array_t<T, py::array::c_style>>(required);
 }
 
 // Inputs of reconstruct and simulate, kept alive (and referenced by `recording`) for the call.
@@ -77,6 +97,9 @@ struct RecordingInput {
   RecordingArrays recording;
 };
 
+// The frames are read where they lie, through their strides (RecordingArrays): a view of any
+// layout, a broadcast one of a huge shape included, costs no copy. Its sizes are checked here,
+// before anything reads it.
 void SetFrames(py::handle frames_object, RecordingInput* input) {
   if (!py::isinstance<py::array>(frames_object)) {
     throw InvalidArgumentError("frames must be a NumPy array (3-D float32 or float64), not " +
@@ -85,27 +108,41 @@ void SetFrames(py::handle frames_object, RecordingInput* input) {
   const py::array frames = py::reinterpret_borrow<py::array>(frames_object);
   RecordingArrays& recording = input->recording;
   if (frames.dtype().is(py::dtype::of<float>())) {
-    const auto checked = CheckedArray<float>(frames, 3, "frames");
-    recording.frames_float32 = checked.data();
-    input->frames = checked;
+    CheckedDtypeAndRank<float>(frames, 3, "frames");
+    recording.frames_float32 = true;
   } else if (frames.dtype().is(py::dtype::of<double>())) {
-    const auto checked = CheckedArray<double>(frames, 3, "frames");
-    recording.frames_float64 = checked.data();
-    input->frames = checked;
+    CheckedDtypeAndRank<double>(frames, 3, "frames");
+    recording.frames_float32 = false;
   } else {
     throw InvalidArgumentError(
         "frames must be a 3-D float32 or float64 array (frames x height "
         "x width, intensities in [0, 1]), not " +
         DtypeName(frames));
   }
-  for (int axis = 0; axis < 3; ++axis) {
-    if (input->frames.shape(axis) > std::numeric_limits<int>::max()) {
-      throw InvalidArgumentError("frames is too large");
-    }
+  const py::ssize_t count = frames.shape(0), height = frames.shape(1), width = frames.shape(2);
+  if (count < 1 || height < 1 || width < 1) {
+    throw InvalidArgumentError("frames must hold at least one frame of at least 1x1 pixels, not " +
+                               std::to_string(count) + "x" + std::to_string(height) + "x" +
+                               std::to_string(width));
   }
-  recording.num_frames = static_cast<int>(input->frames.shape(0));
-  recording.height = static_cast<int>(input->frames.shape(1));
-  recording.width = static_cast<int>(input->frames.shape(2));
+  if (height > kMaxSensorSide || width > kMaxSensorSide ||
+      static_cast<int64_t>(height) * width > kMaxSensorPixels) {
+    throw InvalidArgumentError("frames of " + std::to_string(width) + "x" + std::to_string(height) +
+                               " pixels are larger than the " + std::to_string(kMaxSensorPixels) +
+                               " pixels (8192x8192) evfs reads");
+  }
+  if (count > std::numeric_limits<int>::max()) {
+    throw InvalidArgumentError("frames holds " + std::to_string(count) +
+                               " frames, more than the 2^31-1 evfs indexes");
+  }
+  input->frames = frames;
+  recording.frames_data = static_cast<const char*>(frames.data());
+  recording.frame_stride = frames.strides(0);
+  recording.row_stride = frames.strides(1);
+  recording.column_stride = frames.strides(2);
+  recording.num_frames = static_cast<int>(count);
+  recording.height = static_cast<int>(height);
+  recording.width = static_cast<int>(width);
 }
 
 void SetFrameTimes(py::handle times_object, RecordingInput* input) {
@@ -169,6 +206,60 @@ void SetEvents(py::handle events_object, RecordingInput* input) {
   recording.event_y = input->event_y.data();
   recording.event_polarity = input->event_p.data();
   recording.num_events = static_cast<size_t>(count);
+}
+
+// How often the calling thread looks for a signal while a job runs.
+constexpr auto kSignalPollInterval = std::chrono::milliseconds(20);
+
+// Runs `job` without the GIL on a thread of its own, while the calling thread looks for a
+// signal every kSignalPollInterval. Python runs its signal handlers only in the main thread,
+// between bytecodes: a job that held the calling thread would keep Ctrl-C waiting until it
+// ended. When a handler raises (KeyboardInterrupt on SIGINT), `cancel` is set, and the job
+// stops at its next check (a solver iteration, a window, a frame); the handler's exception is
+// raised once the job has ended, since the job reads the caller's arrays and writes staging
+// folders that must not be released under it. `job` must not touch Python objects.
+void RunInterruptibly(const std::function<void(const std::atomic<bool>& cancel)>& job) {
+  std::atomic<bool> cancel(false);
+  std::mutex mutex;
+  std::condition_variable finished_changed;
+  bool finished = false;
+  std::exception_ptr job_error;
+  PyObject* signal_type = nullptr;
+  PyObject* signal_value = nullptr;
+  PyObject* signal_traceback = nullptr;
+  {
+    py::gil_scoped_release release;
+    std::thread worker([&] {
+      try {
+        job(cancel);
+      } catch (...) {
+        job_error = std::current_exception();
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      finished = true;
+      finished_changed.notify_all();
+    });
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!finished_changed.wait_for(lock, kSignalPollInterval, [&] { return finished; })) {
+      if (cancel) continue;
+      lock.unlock();
+      {
+        const py::gil_scoped_acquire acquire;
+        if (PyErr_CheckSignals() != 0) {
+          PyErr_Fetch(&signal_type, &signal_value, &signal_traceback);
+          cancel = true;
+        }
+      }
+      lock.lock();
+    }
+    lock.unlock();
+    worker.join();
+  }
+  if (signal_type != nullptr) {
+    PyErr_Restore(signal_type, signal_value, signal_traceback);
+    throw py::error_already_set();
+  }
+  if (job_error) std::rethrow_exception(job_error);
 }
 
 // A NumPy array over `values`, which it keeps alive: no copy.
@@ -239,15 +330,15 @@ py::dict ReadArrays(const std::string& path) {
   }
   double* image_data = images.mutable_data();
   EventStream events(source->width(), source->height());
-  {
-    py::gil_scoped_release release;
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
     const size_t pixels = static_cast<size_t>(source->width()) * source->height();
     for (int i = 0; i < num_frames; ++i) {
+      if (cancel) throw Interrupted();
       const Image image = source->ReadImage(i);
       std::copy(image.data(), image.data() + pixels, image_data + i * pixels);
     }
     if (source->has_events()) events = source->ReadAllEvents();
-  }
+  });
   py::dict result;
   result["path"] = path;
   result["width"] = source->width();
@@ -298,13 +389,20 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   SetEvents(events, &input);
   ReconstructResult result;
   std::string summary;
-  {
-    py::gil_scoped_release release;
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
     CheckRecordingArrays(input.recording, "frames", "events");
     const ArraySource source(input.recording, kArraysLabel);
-    result = RunReconstruction(request, source);
+    // A stopped solve returns its current iterate; the next stage, or the check after the
+    // job, turns it into Interrupted, so that it is never returned as a result.
+    ReconstructRequest interruptible = request;
+    interruptible.progress = [&cancel](const SolverIteration&) { return !cancel; };
+    interruptible.stage = [&cancel](const char*) {
+      if (cancel) throw Interrupted();
+    };
+    result = RunReconstruction(interruptible, source);
+    if (cancel) throw Interrupted();
     summary = SummaryJson(request, result);
-  }
+  });
   py::dict output;
   output["times"] = Seconds(result.output.timestamps_ns());
   output["frames"] = VideoArray(std::move(result.output), dtype);
@@ -322,8 +420,7 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
   SetFrames(frames, &input);
   SetFrameTimes(frame_times, &input);
   EventStream events;
-  {
-    py::gil_scoped_release release;
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
     const RecordingArrays& recording = input.recording;
     CheckRecordingArrays(recording, "frames", "events");
     if (recording.num_frames < 2) {
@@ -333,16 +430,17 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
     const ArraySource source(recording, kArraysLabel);
     Video video;
     for (int i = 0; i < recording.num_frames; ++i) {
+      if (cancel) throw Interrupted();
       video.AppendFrame(source.ReadImage(i), recording.frame_t_ns[i]);
     }
     events = SimulateEvents(video, simulator);
-  }
+  });
   return EventsDict(std::move(events));
 }
 
 // evfs.video: `evfs video` without MPI, into a folder through the same OutputTarget (so the
 // same refusals and the same atomic replacement). Unlike the command line it runs in this
-// process: a signal leaves the staging folder, and the resumable work folder, behind.
+// process; Ctrl-C stops it through RunInterruptibly.
 py::dict VideoFromPath(const std::string& data, const std::string& out, const py::int_& first,
                        const py::int_& last, double fps, const py::int_& jobs,
                        const py::int_& frame_step, bool predict_tail, bool preview, bool resume,
@@ -379,14 +477,18 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   output.inputs = {data};
   VideoResult result;
   std::string path;
-  {
-    py::gil_scoped_release release;
+  // Interrupted, the staging folder goes with the OutputTarget (nothing is committed) and the
+  // work folder stays for resume, as after the command line's Ctrl-C.
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
+    VideoRequest interruptible = request;
+    interruptible.cancelled = [&cancel] { return cancel.load(); };
     OutputTarget target(output);
-    result = RunVideo(request, target.path(), target.staging());
+    result = RunVideo(interruptible, target.path(), target.staging());
+    if (cancel) throw Interrupted();
     target.Commit();
     RemoveVideoWorkFolder(target.path());
     path = target.path();
-  }
+  });
   py::dict summary;
   summary["path"] = path;
   summary["windows"] = result.windows;
@@ -419,7 +521,9 @@ PYBIND11_MODULE(evfs, m) {
       "read(path) loads a recording; reconstruct(...) synthesises latent frames from frames and "
       "events; simulate(...) makes events from frames. Options are the command line's flags "
       "(reconstruct_defaults(), simulate_defaults()). User errors raise ValueError with the "
-      "command line's message, a failed solve RuntimeError.";
+      "command line's message, a failed solve RuntimeError, an input too large for memory "
+      "MemoryError. Ctrl-C stops a running call with KeyboardInterrupt and keeps nothing it "
+      "was writing (video keeps its work folder for resume=True).";
   m.attr("__version__") = evfs::kVersion;
 
   py::register_exception_translator([](std::exception_ptr error) {

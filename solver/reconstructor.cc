@@ -170,7 +170,8 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
 
 // One Levenberg–Marquardt solve of `solve_options`' objective from result->video, which it
 // updates; adds its times and iterations to result->summary and sets the rest from this solve.
-void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_options,
+// Returns whether `callback` stopped the solve.
+bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_options,
                    const IterationCallback& callback, Reconstruction* result) {
   ReconstructionSummary& summary = result->summary;
   const int threads = std::max(1, solve_options.solver.num_threads);
@@ -271,7 +272,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   summary.problem.skipped_pixels -= summary.problem.active_pixels;
   if (!any_unknowns) {
     summary.skipped_reason = "no unknowns: no pixel is active";
-    return;
+    return adapter && adapter->stopped();
   }
   summary.iterations += iterations;
   if (summary.ceres.termination_type == ceres::FAILURE) {
@@ -283,6 +284,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   plan.layout().Expand(&result->video);
   summary.ramped_steps =
       RampSteps(scene, plan.layout(), solve_options.step_ramp_px, &result->video);
+  return adapter && adapter->stopped();
 }
 
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
@@ -318,8 +320,9 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     // Steps are ramped once, on the answer; with a prior (plug & play's x-update) the solve's
     // answer is the minimiser it asked for.
     if (i + 1 < scales.size() || options.objective.prior_weight != 0.0) stage.step_ramp_px = 0.0;
-    BuildAndSolve(scene, stage, callback, &result);
-    if (!summary.solved) break;  // nothing to solve
+    const bool stopped = BuildAndSolve(scene, stage, callback, &result);
+    // A callback that stops the solve stops it whole: no later scale is built and solved.
+    if (stopped || !summary.solved) break;
   }
   // With a prior (plug & play's x-update) the solve's answer is the minimiser it asked for.
   if (options.quiet_blend_fraction > 0.0 && options.objective.prior_weight == 0.0 &&
