@@ -81,6 +81,14 @@ void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& fram
       }
     }
   }
+  if (arrays.num_frames > kMaxArrayFrames) {
+    fail(frames_name + " holds " + std::to_string(arrays.num_frames) + " frames, more than the " +
+         std::to_string(kMaxArrayFrames) + " an array recording may hold");
+  }
+  if (arrays.num_events > static_cast<size_t>(kMaxArrayEvents)) {
+    fail(events_name + " holds " + std::to_string(arrays.num_events) + " events, more than the " +
+         std::to_string(kMaxArrayEvents) + " an array recording may hold");
+  }
   if (arrays.frame_t_ns.size() != static_cast<size_t>(arrays.num_frames)) {
     fail("frame_times must hold one time per frame: " + std::to_string(arrays.num_frames) +
          " frames, " + std::to_string(arrays.frame_t_ns.size()) + " times");
@@ -140,11 +148,17 @@ Image ArraySource::ReadImage(int index) const {
 
 size_t ArraySource::LowerBound(int64_t t_ns) const {
   // SecondsToNanoseconds is non-decreasing, so the converted times are sorted too.
-  const double* begin = arrays_.event_t_s;
-  const double* found = std::partition_point(begin, begin + arrays_.num_events, [t_ns](double t_s) {
-    return SecondsToNanoseconds(t_s) < t_ns;
-  });
-  return static_cast<size_t>(found - begin);
+  size_t first = 0, count = arrays_.num_events;
+  while (count > 0) {
+    const size_t half = count / 2;
+    if (SecondsToNanoseconds(arrays_.event_t_s[first + half]) < t_ns) {
+      first += half + 1;
+      count -= half + 1;
+    } else {
+      count = half;
+    }
+  }
+  return first;
 }
 
 EventStream ArraySource::Copy(size_t first, size_t last) const {

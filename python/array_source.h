@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,27 @@ namespace evfs {
 /// Largest side of the frames: event coordinates are uint16. Their area is bounded further by
 /// kMaxSensorPixels (io/image_io.h), as for every recording evfs reads.
 inline constexpr int kMaxSensorSide = 65536;
+
+/// Most frames an array recording may hold: one per millisecond for over 16 minutes. Each frame
+/// costs bookkeeping (its time, its name) whatever its pixels, and a zero-stride view declares
+/// any count without occupying memory.
+inline constexpr int64_t kMaxArrayFrames = 1000000;
+/// Most events an array recording may hold: what 32-bit signed indexes count.
+inline constexpr int64_t kMaxArrayEvents = (int64_t{1} << 31) - 1;
+
+/// One element of T every `stride` bytes from `data` (any sign, zero included, unaligned
+/// allowed): a 1-D NumPy array read where it lies, without a copy.
+template <typename T>
+struct StridedArray {
+  const char* data = nullptr;
+  int64_t stride = 0;
+
+  T operator[](size_t i) const {
+    T value;
+    std::memcpy(&value, data + static_cast<int64_t>(i) * stride, sizeof(value));
+    return value;
+  }
+};
 
 /// Borrowed arrays of a recording. Every pointer must stay valid, and its data unchanged, for
 /// the lifetime of the ArraySource made from it.
@@ -43,10 +65,10 @@ struct RecordingArrays {
   std::vector<int64_t> exposure_end_ns;
   /// num_events events in time order: t in seconds (never decreasing), x < width, y < height,
   /// polarity ±1.
-  const double* event_t_s = nullptr;
-  const uint16_t* event_x = nullptr;
-  const uint16_t* event_y = nullptr;
-  const int8_t* event_polarity = nullptr;
+  StridedArray<double> event_t_s;
+  StridedArray<uint16_t> event_x;
+  StridedArray<uint16_t> event_y;
+  StridedArray<int8_t> event_polarity;
   size_t num_events = 0;
 };
 

@@ -87,13 +87,20 @@ py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
   return py::reinterpret_borrow<py::array_t<T, py::array::c_style>>(required);
 }
 
+// A checked 1-D array (CheckedDtypeAndRank) as a StridedArray over its memory.
+template <typename T>
+StridedArray<T> Strided(const py::array& array) {
+  StridedArray<T> strided;
+  strided.data = static_cast<const char*>(array.data());
+  strided.stride = array.strides(0);
+  return strided;
+}
+
 // Inputs of reconstruct and simulate, kept alive (and referenced by `recording`) for the call.
 struct RecordingInput {
   py::array frames;
   py::array_t<double, py::array::c_style> frame_times;
-  py::array_t<double, py::array::c_style> event_t;
-  py::array_t<uint16_t, py::array::c_style> event_x, event_y;
-  py::array_t<int8_t, py::array::c_style> event_p;
+  py::array event_t, event_x, event_y, event_p;
   RecordingArrays recording;
 };
 
@@ -131,9 +138,9 @@ void SetFrames(py::handle frames_object, RecordingInput* input) {
                                " pixels are larger than the " + std::to_string(kMaxSensorPixels) +
                                " pixels (8192x8192) evfs reads");
   }
-  if (count > std::numeric_limits<int>::max()) {
-    throw InvalidArgumentError("frames holds " + std::to_string(count) +
-                               " frames, more than the 2^31-1 evfs indexes");
+  if (count > kMaxArrayFrames) {
+    throw InvalidArgumentError("frames holds " + std::to_string(count) + " frames, more than the " +
+                               std::to_string(kMaxArrayFrames) + " an array recording may hold");
   }
   input->frames = frames;
   recording.frames_data = static_cast<const char*>(frames.data());
@@ -145,8 +152,15 @@ void SetFrames(py::handle frames_object, RecordingInput* input) {
   recording.width = static_cast<int>(width);
 }
 
+// After SetFrames: the length is checked against the frames before anything is copied.
 void SetFrameTimes(py::handle times_object, RecordingInput* input) {
-  input->frame_times = CheckedArray<double>(times_object, 1, "frame_times");
+  const py::array times_array = CheckedDtypeAndRank<double>(times_object, 1, "frame_times");
+  if (times_array.shape(0) != input->recording.num_frames) {
+    throw InvalidArgumentError(
+        "frame_times must hold one time per frame: " + std::to_string(input->recording.num_frames) +
+        " frames, " + std::to_string(times_array.shape(0)) + " times");
+  }
+  input->frame_times = CheckedArray<double>(times_array, 1, "frame_times");
   const auto times = input->frame_times.unchecked<1>();
   for (py::ssize_t i = 0; i < times.shape(0); ++i) {
     input->recording.frame_t_ns.push_back(
@@ -157,14 +171,15 @@ void SetFrameTimes(py::handle times_object, RecordingInput* input) {
 // exposures: None, or frames × 2 (begin, end) in seconds with NaN rows for frames without one.
 void SetExposures(py::handle exposures_object, RecordingInput* input) {
   if (exposures_object.is_none()) return;
-  const auto exposures = CheckedArray<double>(exposures_object, 2, "exposures");
+  const py::array unchecked = CheckedDtypeAndRank<double>(exposures_object, 2, "exposures");
   RecordingArrays& recording = input->recording;
-  if (exposures.shape(0) != recording.num_frames || exposures.shape(1) != 2) {
+  if (unchecked.shape(0) != recording.num_frames || unchecked.shape(1) != 2) {
     throw InvalidArgumentError(
         "exposures must be a frames x 2 array (begin, end in seconds; NaN "
         "where a frame has none): " +
         std::to_string(recording.num_frames) + " x 2 here");
   }
+  const auto exposures = CheckedArray<double>(unchecked, 2, "exposures");
   const auto view = exposures.unchecked<2>();
   for (int i = 0; i < recording.num_frames; ++i) {
     const bool known = !std::isnan(view(i, 0)) || !std::isnan(view(i, 1));
@@ -191,20 +206,25 @@ void SetEvents(py::handle events_object, RecordingInput* input) {
                                  "': expected arrays 't', 'x', 'y' and 'p'");
     }
   }
-  input->event_t = CheckedArray<double>(events["t"], 1, "events['t']");
-  input->event_x = CheckedArray<uint16_t>(events["x"], 1, "events['x']");
-  input->event_y = CheckedArray<uint16_t>(events["y"], 1, "events['y']");
-  input->event_p = CheckedArray<int8_t>(events["p"], 1, "events['p']");
+  // Read where they lie, through their strides (StridedArray): no layout costs a copy.
+  input->event_t = CheckedDtypeAndRank<double>(events["t"], 1, "events['t']");
+  input->event_x = CheckedDtypeAndRank<uint16_t>(events["x"], 1, "events['x']");
+  input->event_y = CheckedDtypeAndRank<uint16_t>(events["y"], 1, "events['y']");
+  input->event_p = CheckedDtypeAndRank<int8_t>(events["p"], 1, "events['p']");
   const py::ssize_t count = input->event_t.shape(0);
   if (input->event_x.shape(0) != count || input->event_y.shape(0) != count ||
       input->event_p.shape(0) != count) {
     throw InvalidArgumentError("events['t'], ['x'], ['y'] and ['p'] must have the same length");
   }
   RecordingArrays& recording = input->recording;
-  recording.event_t_s = input->event_t.data();
-  recording.event_x = input->event_x.data();
-  recording.event_y = input->event_y.data();
-  recording.event_polarity = input->event_p.data();
+  if (count > kMaxArrayEvents) {
+    throw InvalidArgumentError("events holds " + std::to_string(count) + " events, more than the " +
+                               std::to_string(kMaxArrayEvents) + " an array recording may hold");
+  }
+  recording.event_t_s = Strided<double>(input->event_t);
+  recording.event_x = Strided<uint16_t>(input->event_x);
+  recording.event_y = Strided<uint16_t>(input->event_y);
+  recording.event_polarity = Strided<int8_t>(input->event_p);
   recording.num_events = static_cast<size_t>(count);
 }
 
