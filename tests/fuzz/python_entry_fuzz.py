@@ -14,9 +14,11 @@ recordings that run a short solve.
 
   PYTHONPATH=build/python python3 tests/fuzz/python_entry_fuzz.py --seed=1 --calls=1000000
 
-Exit status: 0 when every case ended in a return or an allowed exception, 1 otherwise.
+Exit status: 0 when every case ended in a return or an allowed exception, 1 otherwise, 77
+(ctest's "skipped") when NumPy or the evfs module cannot be imported.
 """
 import argparse
+import importlib.util
 import os
 import random
 import subprocess
@@ -24,6 +26,7 @@ import sys
 import tempfile
 import time
 
+SKIPPED = 77
 ALLOWED = (ValueError, TypeError, MemoryError, RuntimeError, OverflowError)
 # A call longer than this is reported as slow (it is no crash, but the fuzzed inputs are small).
 SLOW_CALL_S = 20.0
@@ -351,6 +354,10 @@ def main():
         print(finding or "no finding")
         return 1 if finding else 0
 
+    missing = [m for m in ("numpy", "evfs") if importlib.util.find_spec(m) is None]
+    if missing:
+        print("skipped: " + ", ".join(missing) + " not importable by " + sys.executable)
+        return SKIPPED
     start = time.monotonic()
     done = crashes = findings = 0
     outcomes = {}
