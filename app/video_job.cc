@@ -496,6 +496,8 @@ bool VideoRequest::IsValid(std::string* error) const {
   check.Valid(windows)
       .Require(std::isfinite(fps) && (fps == 0.0 || fps >= kMinVideoFps), "--fps",
                "0 (derived) or at least 1 frame per second")
+      .Require(!(fps > kMaxVideoFps), "--fps",
+               "at most 1e9 frames per second (output times are whole nanoseconds)")
       .InRange("--jobs", jobs, 0, 4096)
       .InRange("--threads", threads_per_window, 0, 4096)
       .Valid(method.reconstruction)

@@ -55,8 +55,11 @@ int64_t CheckedNanoseconds(double t_s, const std::string& what) {
 }
 
 void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& frames_name,
-                          const std::string& events_name) {
+                          const std::string& events_name, const std::atomic<bool>* cancel) {
   const auto fail = [](const std::string& message) { throw InvalidArgumentError(message); };
+  const auto stop_if_cancelled = [cancel] {
+    if (cancel != nullptr && *cancel) throw Interrupted();
+  };
   if (arrays.num_frames < 1 || arrays.height < 1 || arrays.width < 1) {
     fail(frames_name + " must hold at least one frame of at least 1x1 pixels");
   }
@@ -70,6 +73,7 @@ void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& fram
          std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
   }
   for (int frame = 0; frame < arrays.num_frames; ++frame) {
+    stop_if_cancelled();
     for (int row = 0; row < arrays.height; ++row) {
       for (int column = 0; column < arrays.width; ++column) {
         const double value = FrameValue(arrays, frame, row, column);
@@ -107,7 +111,9 @@ void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& fram
     }
   }
   double previous_t_s = -std::numeric_limits<double>::infinity();
+  constexpr size_t kEventsBetweenCancelChecks = size_t{1} << 20;
   for (size_t i = 0; i < arrays.num_events; ++i) {
+    if (i % kEventsBetweenCancelChecks == 0) stop_if_cancelled();
     const double t_s = arrays.event_t_s[i];
     CheckedNanoseconds(t_s, events_name + "['t'][" + std::to_string(i) + "]");
     if (t_s < previous_t_s) {

@@ -5,6 +5,7 @@
 #ifndef EVFS_PYTHON_ARRAY_SOURCE_H_
 #define EVFS_PYTHON_ARRAY_SOURCE_H_
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -78,9 +79,12 @@ int64_t CheckedNanoseconds(double t_s, const std::string& what);
 
 /// Checks a RecordingArrays against the contract above and throws InvalidArgumentError naming
 /// the first thing that breaks it: `frames_name` and `events_name` are how the message calls
-/// the arrays (the Python argument names).
+/// the arrays (the Python argument names). When `cancel` is given and becomes true, it throws
+/// Interrupted at its next frame or million events: a zero-stride view may declare far more
+/// values than it holds, and its check must not outlast Ctrl-C.
 void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& frames_name,
-                          const std::string& events_name);
+                          const std::string& events_name,
+                          const std::atomic<bool>* cancel = nullptr);
 
 /// The DataSource over checked RecordingArrays. Frames are named "frame N" in messages and
 /// summaries; path() is `label`.

@@ -410,7 +410,7 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   ReconstructResult result;
   std::string summary;
   RunInterruptibly([&](const std::atomic<bool>& cancel) {
-    CheckRecordingArrays(input.recording, "frames", "events");
+    CheckRecordingArrays(input.recording, "frames", "events", &cancel);
     const ArraySource source(input.recording, kArraysLabel);
     // A stopped solve returns its current iterate; the next stage, or the check after the
     // job, turns it into Interrupted, so that it is never returned as a result.
@@ -442,7 +442,7 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
   EventStream events;
   RunInterruptibly([&](const std::atomic<bool>& cancel) {
     const RecordingArrays& recording = input.recording;
-    CheckRecordingArrays(recording, "frames", "events");
+    CheckRecordingArrays(recording, "frames", "events", &cancel);
     if (recording.num_frames < 2) {
       throw InvalidArgumentError("simulate needs at least 2 frames (" +
                                  std::to_string(recording.num_frames) + " found)");
