@@ -709,3 +709,11 @@ def test_ctrl_c_stops_video_and_commits_nothing(demo, tmp_path):
     # staging folder.
     assert left in ([], [".video.evfs-video-work"]), left
     assert not any("evfs-tmp" in name for name in left)
+
+
+def test_video_fps_beyond_one_per_nanosecond_is_refused(demo, tmp_path):
+    # Output times are whole nanoseconds: a faster rate's step rounds to zero, and the output
+    # clock would never advance.
+    with pytest.raises(ValueError, match="--fps must be at most 1e9 frames per second"):
+        evfs.video(str(demo / "data"), str(tmp_path / "v"), fps=1e308)
+    assert not any(tmp_path.iterdir())
