@@ -552,6 +552,8 @@ bool VideoRequest::IsValid(std::string* error) const {
   check.Valid(windows)
       .Require(std::isfinite(fps) && (fps == 0.0 || fps >= kMinVideoFps), "--fps",
                "0 (derived) or at least 1 frame per second")
+      .Require(!(fps > kMaxVideoFps), "--fps",
+               "at most 1e9 frames per second (output times are whole nanoseconds)")
       .InRange("--jobs", jobs, 0, 4096)
       .InRange("--threads", threads_per_window, 0, 4096)
       .Valid(method.reconstruction)
@@ -820,10 +822,18 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   std::mutex take_mutex;
   size_t next_pending = 0;
   int solved = 0;
+  const auto stop_requested = [&request] {
+    return request.method.interrupt != nullptr && request.method.interrupt->load();
+  };
+  const auto stop_if_requested = [&] {
+    if (!stop_requested()) return;
+    remove_on_error.armed = false;
+    throw InterruptedError("interrupted: the windows finished so far are kept for --resume");
+  };
   const auto take = [&]() -> int {
     const std::lock_guard<std::mutex> lock(take_mutex);
     if (failed) return -1;  // an earlier window failed: the run ends with its error
-    if (request.method.interrupt != nullptr && request.method.interrupt->load()) {
+    if (stop_requested()) {
       failed = true;
       return -1;
     }
@@ -852,7 +862,8 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
           records[index] = std::move(record);
           if (request.progress) request.progress(progress);
         } catch (const InterruptedError&) {
-          failed = true;  // the check after the loop reports it
+          // Not a failure of the run: the work folder stays for resume (checked below).
+          failed = true;
         } catch (...) {
           failed = true;
           throw;
@@ -860,11 +871,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
       }
     });
   }
-  if (request.method.interrupt != nullptr && request.method.interrupt->load()) {
-    // Like a signal, an interrupt keeps the finished windows for --resume.
-    remove_on_error.armed = false;
-    throw InterruptedError("interrupted: the windows finished so far are kept for --resume");
-  }
+  stop_if_requested();
   result.solve_wall_s = SecondsSince(solve_start);
   result.windows_per_s = result.solve_wall_s > 0.0 ? solved / result.solve_wall_s : 0.0;
   result.events_per_s =
@@ -880,6 +887,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   fs::create_directories(out / "confidence");
   std::vector<int64_t> times;
   for (int64_t n = 0; n < result.output_frames; ++n) {
+    stop_if_requested();
     for (const char* folder : {"frames", "confidence"}) {
       LinkFrame(work / folder / (FrameName(n) + ".png"), out / folder / (FrameName(n) + ".png"));
     }
@@ -889,6 +897,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   {
     Mp4Writer video((out / "video.mp4").string(), fps, result.width, result.height);
     for (int64_t n = 0; n < result.output_frames; ++n) {
+      stop_if_requested();
       video.WriteGrey(ReadGreyImage((work / "frames" / (FrameName(n) + ".png")).string()));
     }
     video.Close();

@@ -42,6 +42,9 @@ inline constexpr double kDefaultUpsampling = 10.0;
 /// Slowest output rate: the MP4 encoder keeps the rate as a fraction with a small denominator
 /// and refuses rates near 0, and a video that upsamples frames is never slower than 1 fps.
 inline constexpr double kMinVideoFps = 1.0;
+/// Highest --fps: output times are whole nanoseconds, so a faster rate has no distinct frame
+/// times (its step rounds to zero and the output clock would never advance).
+inline constexpr double kMaxVideoFps = 1e9;
 
 /// Where a video job stands, after each window.
 struct VideoProgress {

@@ -41,10 +41,12 @@ class SolverError : public Error {
   explicit SolverError(const std::string& message) : Error(message) {}
 };
 
-/// The caller asked the work to stop (MethodOptions::interrupt): what it had done is discarded.
+/// The caller asked a running job to stop (MethodOptions::interrupt, the Python module when
+/// Ctrl-C arrives): the job ends at its next check, and nothing it was making is kept as if
+/// complete.
 class InterruptedError : public Error {
  public:
-  explicit InterruptedError(const std::string& message) : Error(message) {}
+  explicit InterruptedError(const std::string& message = "interrupted") : Error(message) {}
 };
 
 /// A value given by the user (an option, a flag, an index) is outside what is accepted.

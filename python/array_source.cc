@@ -2,16 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "core/error.h"
 #include "core/time.h"
+#include "io/image_io.h"
 
 namespace evfs {
 namespace {
 
-// Largest sensor side: event coordinates are uint16.
-constexpr int kMaxSensorSide = 65536;
 // Largest |time| in seconds that int64 nanoseconds hold with room to spare (2^63 ns ≈ 9.2e9 s).
 constexpr double kMaxAbsTimeS = 9.0e9;
 
@@ -30,9 +30,18 @@ std::vector<FrameInfo> FrameInfos(const RecordingArrays& arrays) {
   return frames;
 }
 
-double FrameValue(const RecordingArrays& arrays, size_t i) {
-  return arrays.frames_float32 != nullptr ? static_cast<double>(arrays.frames_float32[i])
-                                          : arrays.frames_float64[i];
+// Element [frame, row, column]; memcpy, since a view's elements need not be aligned.
+double FrameValue(const RecordingArrays& arrays, int frame, int row, int column) {
+  const char* element = arrays.frames_data + frame * arrays.frame_stride + row * arrays.row_stride +
+                        column * arrays.column_stride;
+  if (arrays.frames_float32) {
+    float value = 0.0f;
+    std::memcpy(&value, element, sizeof(value));
+    return value;
+  }
+  double value = 0.0;
+  std::memcpy(&value, element, sizeof(value));
+  return value;
 }
 
 }  // namespace
@@ -46,8 +55,11 @@ int64_t CheckedNanoseconds(double t_s, const std::string& what) {
 }
 
 void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& frames_name,
-                          const std::string& events_name) {
+                          const std::string& events_name, const std::atomic<bool>* cancel) {
   const auto fail = [](const std::string& message) { throw InvalidArgumentError(message); };
+  const auto stop_if_cancelled = [cancel] {
+    if (cancel != nullptr && *cancel) throw InterruptedError();
+  };
   if (arrays.num_frames < 1 || arrays.height < 1 || arrays.width < 1) {
     fail(frames_name + " must hold at least one frame of at least 1x1 pixels");
   }
@@ -55,16 +67,31 @@ void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& fram
     fail(frames_name + " frames must be at most " + std::to_string(kMaxSensorSide) +
          " pixels on a side (event coordinates are uint16)");
   }
-  const size_t values = static_cast<size_t>(arrays.num_frames) * arrays.height * arrays.width;
-  for (size_t i = 0; i < values; ++i) {
-    const double value = FrameValue(arrays, i);
-    if (!(value >= 0.0 && value <= 1.0)) {
-      const size_t pixels = static_cast<size_t>(arrays.height) * arrays.width;
-      const size_t in_frame = i % pixels;
-      fail(frames_name + " must hold intensities in [0, 1]: [" + std::to_string(i / pixels) + ", " +
-           std::to_string(in_frame / arrays.width) + ", " +
-           std::to_string(in_frame % arrays.width) + "] is " + std::to_string(value));
+  if (static_cast<int64_t>(arrays.height) * arrays.width > kMaxSensorPixels) {
+    fail(frames_name + " holds frames of " + std::to_string(arrays.width) + "x" +
+         std::to_string(arrays.height) + " pixels, more than the " +
+         std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
+  }
+  for (int frame = 0; frame < arrays.num_frames; ++frame) {
+    stop_if_cancelled();
+    for (int row = 0; row < arrays.height; ++row) {
+      for (int column = 0; column < arrays.width; ++column) {
+        const double value = FrameValue(arrays, frame, row, column);
+        if (!(value >= 0.0 && value <= 1.0)) {
+          fail(frames_name + " must hold intensities in [0, 1]: [" + std::to_string(frame) + ", " +
+               std::to_string(row) + ", " + std::to_string(column) + "] is " +
+               std::to_string(value));
+        }
+      }
     }
+  }
+  if (arrays.num_frames > kMaxArrayFrames) {
+    fail(frames_name + " holds " + std::to_string(arrays.num_frames) + " frames, more than the " +
+         std::to_string(kMaxArrayFrames) + " an array recording may hold");
+  }
+  if (arrays.num_events > static_cast<size_t>(kMaxArrayEvents)) {
+    fail(events_name + " holds " + std::to_string(arrays.num_events) + " events, more than the " +
+         std::to_string(kMaxArrayEvents) + " an array recording may hold");
   }
   if (arrays.frame_t_ns.size() != static_cast<size_t>(arrays.num_frames)) {
     fail("frame_times must hold one time per frame: " + std::to_string(arrays.num_frames) +
@@ -84,7 +111,9 @@ void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& fram
     }
   }
   double previous_t_s = -std::numeric_limits<double>::infinity();
+  constexpr size_t kEventsBetweenCancelChecks = size_t{1} << 20;
   for (size_t i = 0; i < arrays.num_events; ++i) {
+    if (i % kEventsBetweenCancelChecks == 0) stop_if_cancelled();
     const double t_s = arrays.event_t_s[i];
     CheckedNanoseconds(t_s, events_name + "['t'][" + std::to_string(i) + "]");
     if (t_s < previous_t_s) {
@@ -115,18 +144,27 @@ Image ArraySource::ReadImage(int index) const {
                                " has " + std::to_string(arrays_.num_frames) + " frames");
   }
   Image image(arrays_.height, arrays_.width);
-  const size_t offset = static_cast<size_t>(index) * arrays_.height * arrays_.width;
-  for (Eigen::Index i = 0; i < image.size(); ++i) image.data()[i] = FrameValue(arrays_, offset + i);
+  for (int row = 0; row < arrays_.height; ++row) {
+    for (int column = 0; column < arrays_.width; ++column) {
+      image(row, column) = FrameValue(arrays_, index, row, column);
+    }
+  }
   return image;
 }
 
 size_t ArraySource::LowerBound(int64_t t_ns) const {
   // SecondsToNanoseconds is non-decreasing, so the converted times are sorted too.
-  const double* begin = arrays_.event_t_s;
-  const double* found = std::partition_point(begin, begin + arrays_.num_events, [t_ns](double t_s) {
-    return SecondsToNanoseconds(t_s) < t_ns;
-  });
-  return static_cast<size_t>(found - begin);
+  size_t first = 0, count = arrays_.num_events;
+  while (count > 0) {
+    const size_t half = count / 2;
+    if (SecondsToNanoseconds(arrays_.event_t_s[first + half]) < t_ns) {
+      first += half + 1;
+      count -= half + 1;
+    } else {
+      count = half;
+    }
+  }
+  return first;
 }
 
 EventStream ArraySource::Copy(size_t first, size_t last) const {

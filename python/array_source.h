@@ -5,8 +5,10 @@
 #ifndef EVFS_PYTHON_ARRAY_SOURCE_H_
 #define EVFS_PYTHON_ARRAY_SOURCE_H_
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -16,12 +18,43 @@
 
 namespace evfs {
 
+/// Largest side of the frames: event coordinates are uint16. Their area is bounded further by
+/// kMaxSensorPixels (io/image_io.h), as for every recording evfs reads.
+inline constexpr int kMaxSensorSide = 65536;
+
+/// Most frames an array recording may hold: one per millisecond for over 16 minutes. Each frame
+/// costs bookkeeping (its time, its name) whatever its pixels, and a zero-stride view declares
+/// any count without occupying memory.
+inline constexpr int64_t kMaxArrayFrames = 1000000;
+/// Most events an array recording may hold: what 32-bit signed indexes count.
+inline constexpr int64_t kMaxArrayEvents = (int64_t{1} << 31) - 1;
+
+/// One element of T every `stride` bytes from `data` (any sign, zero included, unaligned
+/// allowed): a 1-D NumPy array read where it lies, without a copy.
+template <typename T>
+struct StridedArray {
+  const char* data = nullptr;
+  int64_t stride = 0;
+
+  T operator[](size_t i) const {
+    T value;
+    std::memcpy(&value, data + static_cast<int64_t>(i) * stride, sizeof(value));
+    return value;
+  }
+};
+
 /// Borrowed arrays of a recording. Every pointer must stay valid, and its data unchanged, for
 /// the lifetime of the ArraySource made from it.
 struct RecordingArrays {
-  /// num_frames × height × width intensities in [0, 1], C order; exactly one of the two is set.
-  const float* frames_float32 = nullptr;
-  const double* frames_float64 = nullptr;
+  /// num_frames × height × width intensities in [0, 1], float32 or float64 (frames_float32),
+  /// element [f, r, c] at frames_data + f * frame_stride + r * row_stride + c * column_stride
+  /// bytes. Strides may be negative or zero and elements unaligned: a NumPy view is read where
+  /// it lies, so that no layout (a broadcast view of a huge array included) costs a copy.
+  const char* frames_data = nullptr;
+  bool frames_float32 = false;
+  int64_t frame_stride = 0;
+  int64_t row_stride = 0;
+  int64_t column_stride = 0;
   int num_frames = 0;
   int height = 0;
   int width = 0;
@@ -33,10 +66,10 @@ struct RecordingArrays {
   std::vector<int64_t> exposure_end_ns;
   /// num_events events in time order: t in seconds (never decreasing), x < width, y < height,
   /// polarity ±1.
-  const double* event_t_s = nullptr;
-  const uint16_t* event_x = nullptr;
-  const uint16_t* event_y = nullptr;
-  const int8_t* event_polarity = nullptr;
+  StridedArray<double> event_t_s;
+  StridedArray<uint16_t> event_x;
+  StridedArray<uint16_t> event_y;
+  StridedArray<int8_t> event_polarity;
   size_t num_events = 0;
 };
 
@@ -46,9 +79,12 @@ int64_t CheckedNanoseconds(double t_s, const std::string& what);
 
 /// Checks a RecordingArrays against the contract above and throws InvalidArgumentError naming
 /// the first thing that breaks it: `frames_name` and `events_name` are how the message calls
-/// the arrays (the Python argument names).
+/// the arrays (the Python argument names). When `cancel` is given and becomes true, it throws
+/// Interrupted at its next frame or million events: a zero-stride view may declare far more
+/// values than it holds, and its check must not outlast Ctrl-C.
 void CheckRecordingArrays(const RecordingArrays& arrays, const std::string& frames_name,
-                          const std::string& events_name);
+                          const std::string& events_name,
+                          const std::atomic<bool>* cancel = nullptr);
 
 /// The DataSource over checked RecordingArrays. Frames are named "frame N" in messages and
 /// summaries; path() is `label`.

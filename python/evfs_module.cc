@@ -2,7 +2,7 @@
 // event simulator run on NumPy arrays, through the same application library as the command
 // line (app/). Errors that are the user's become ValueError with the command line's one-line
 // message, a failed solve RuntimeError. The GIL is released while evfs reads, solves and
-// simulates; reconstruct and video stop within an iteration at Ctrl-C (KeyboardInterrupt).
+// simulates, and Ctrl-C stops each of these within a solver iteration (RunInterruptibly).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -10,12 +10,14 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
-#include <future>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
-#include <system_error>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -41,8 +43,6 @@ namespace py = pybind11;
 
 // How summaries and messages name a recording given as arrays.
 constexpr char kArraysLabel[] = "the frames array";
-// The widest and highest frame: event coordinates are uint16.
-constexpr py::ssize_t kMaxSensorSide = 65536;
 
 std::string TypeName(py::handle object) {
   return py::str(py::type::handle_of(object).attr("__name__"));
@@ -50,12 +50,11 @@ std::string TypeName(py::handle object) {
 
 std::string DtypeName(const py::array& array) { return py::str(array.dtype()); }
 
-// `object` as a NumPy array of exactly dtype T with `ndim` dimensions, C-contiguous: the array
-// itself when it is one (no copy), a contiguous copy when only the layout differs. Any other
-// dtype is refused rather than converted, so that no value is silently changed.
+// Whether `object` is a NumPy array of exactly dtype T with `ndim` dimensions; throws
+// InvalidArgumentError naming `name` otherwise. Any other dtype (a byte-swapped one included) is
+// refused rather than converted, so that no value is silently changed.
 template <typename T>
-py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
-                                                const std::string& name) {
+py::array CheckedDtypeAndRank(py::handle object, int ndim, const std::string& name) {
   const std::string expected =
       std::to_string(ndim) + "-D " + std::string(py::str(py::dtype::of<T>()));
   if (!py::isinstance<py::array>(object)) {
@@ -72,112 +71,96 @@ py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
     throw InvalidArgumentError(name + " must be a " + expected + " array, not " +
                                std::to_string(array.ndim()) + "-D");
   }
-  // A strided or broadcast view is copied; a copy that cannot be allocated raises MemoryError
-  // rather than handing on a null array.
-  auto contiguous = py::array_t<T, py::array::c_style>::ensure(array);
-  if (!contiguous) throw py::error_already_set();
-  return contiguous;
+  return array;
 }
 
-// Runs `work` on a thread of its own, without the GIL, while the interpreter's thread waits and
-// runs Python's signal handlers every kSignalPollInterval: when one raises (Ctrl-C's
-// KeyboardInterrupt), `interrupt` asks the work to stop at its next iteration, and once it has,
-// that exception propagates and whatever the work did is discarded. Only the main thread runs
-// signal handlers; called from another, this only waits.
-template <typename Work>
-void RunInterruptible(std::atomic<bool>* interrupt, Work&& work) {
-  constexpr auto kSignalPollInterval = std::chrono::milliseconds(50);
-  std::promise<void> finished;
-  std::future<void> done = finished.get_future();
-  std::thread worker;
-  try {
-    worker = std::thread([&work, &finished] {
-      try {
-        work();
-        finished.set_value();
-      } catch (...) {
-        finished.set_exception(std::current_exception());
-      }
-    });
-  } catch (const std::system_error&) {
-    // No thread to spare: run it here, without the GIL, and without Ctrl-C until it ends.
-    py::gil_scoped_release release;
-    work();
-    return;
-  }
-  bool interrupted = false;
-  for (;;) {
-    std::future_status status;
-    {
-      py::gil_scoped_release release;
-      status = done.wait_for(kSignalPollInterval);
-    }
-    if (status == std::future_status::ready) break;
-    if (PyErr_CheckSignals() != 0) {
-      interrupted = true;
-      interrupt->store(true);
-      break;
-    }
-  }
-  {
-    py::gil_scoped_release release;
-    worker.join();
-  }
-  if (interrupted) throw py::error_already_set();
-  done.get();  // rethrows the work's exception
+// `object` as a C-contiguous, aligned NumPy array of exactly dtype T with `ndim` dimensions:
+// the array itself when it is one, else a copy (numpy.require). A copy that cannot be made
+// raises NumPy's MemoryError; pybind11's array_t::ensure would return an empty handle instead,
+// and reading through it would crash the interpreter.
+template <typename T>
+py::array_t<T, py::array::c_style> CheckedArray(py::handle object, int ndim,
+                                                const std::string& name) {
+  const py::array array = CheckedDtypeAndRank<T>(object, ndim, name);
+  const py::object required = py::module_::import("numpy").attr("require")(
+      array, py::dtype::of<T>(), py::make_tuple("C_CONTIGUOUS", "ALIGNED"));
+  return py::reinterpret_borrow<py::array_t<T, py::array::c_style>>(required);
+}
+
+// A checked 1-D array (CheckedDtypeAndRank) as a StridedArray over its memory.
+template <typename T>
+StridedArray<T> Strided(const py::array& array) {
+  StridedArray<T> strided;
+  strided.data = static_cast<const char*>(array.data());
+  strided.stride = array.strides(0);
+  return strided;
 }
 
 // Inputs of reconstruct and simulate, kept alive (and referenced by `recording`) for the call.
 struct RecordingInput {
   py::array frames;
   py::array_t<double, py::array::c_style> frame_times;
-  py::array_t<double, py::array::c_style> event_t;
-  py::array_t<uint16_t, py::array::c_style> event_x, event_y;
-  py::array_t<int8_t, py::array::c_style> event_p;
+  py::array event_t, event_x, event_y, event_p;
   RecordingArrays recording;
 };
 
+// The frames are read where they lie, through their strides (RecordingArrays): a view of any
+// layout, a broadcast one of a huge shape included, costs no copy. Its sizes are checked here,
+// before anything reads it.
 void SetFrames(py::handle frames_object, RecordingInput* input) {
   if (!py::isinstance<py::array>(frames_object)) {
     throw InvalidArgumentError("frames must be a NumPy array (3-D float32 or float64), not " +
                                TypeName(frames_object));
   }
   const py::array frames = py::reinterpret_borrow<py::array>(frames_object);
-  // The size is bounded before anything is copied or allocated for it, as the readers bound a
-  // declared sensor: a broadcast view of a few bytes may claim gigabytes.
-  if (frames.ndim() == 3 && (frames.shape(1) > kMaxSensorSide || frames.shape(2) > kMaxSensorSide ||
-                             frames.shape(1) * frames.shape(2) > kMaxSensorPixels)) {
-    throw InvalidArgumentError("frames are " + std::to_string(frames.shape(2)) + "x" +
-                               std::to_string(frames.shape(1)) + ": more than the " +
-                               std::to_string(kMaxSensorPixels) + " pixels (8192x8192) evfs reads");
-  }
   RecordingArrays& recording = input->recording;
   if (frames.dtype().is(py::dtype::of<float>())) {
-    const auto checked = CheckedArray<float>(frames, 3, "frames");
-    recording.frames_float32 = checked.data();
-    input->frames = checked;
+    CheckedDtypeAndRank<float>(frames, 3, "frames");
+    recording.frames_float32 = true;
   } else if (frames.dtype().is(py::dtype::of<double>())) {
-    const auto checked = CheckedArray<double>(frames, 3, "frames");
-    recording.frames_float64 = checked.data();
-    input->frames = checked;
+    CheckedDtypeAndRank<double>(frames, 3, "frames");
+    recording.frames_float32 = false;
   } else {
     throw InvalidArgumentError(
         "frames must be a 3-D float32 or float64 array (frames x height "
         "x width, intensities in [0, 1]), not " +
         DtypeName(frames));
   }
-  for (int axis = 0; axis < 3; ++axis) {
-    if (input->frames.shape(axis) > std::numeric_limits<int>::max()) {
-      throw InvalidArgumentError("frames is too large");
-    }
+  const py::ssize_t count = frames.shape(0), height = frames.shape(1), width = frames.shape(2);
+  if (count < 1 || height < 1 || width < 1) {
+    throw InvalidArgumentError("frames must hold at least one frame of at least 1x1 pixels, not " +
+                               std::to_string(count) + "x" + std::to_string(height) + "x" +
+                               std::to_string(width));
   }
-  recording.num_frames = static_cast<int>(input->frames.shape(0));
-  recording.height = static_cast<int>(input->frames.shape(1));
-  recording.width = static_cast<int>(input->frames.shape(2));
+  if (height > kMaxSensorSide || width > kMaxSensorSide ||
+      static_cast<int64_t>(height) * width > kMaxSensorPixels) {
+    throw InvalidArgumentError("frames of " + std::to_string(width) + "x" + std::to_string(height) +
+                               " pixels are larger than the " + std::to_string(kMaxSensorPixels) +
+                               " pixels (8192x8192) evfs reads");
+  }
+  if (count > kMaxArrayFrames) {
+    throw InvalidArgumentError("frames holds " + std::to_string(count) + " frames, more than the " +
+                               std::to_string(kMaxArrayFrames) + " an array recording may hold");
+  }
+  input->frames = frames;
+  recording.frames_data = static_cast<const char*>(frames.data());
+  recording.frame_stride = frames.strides(0);
+  recording.row_stride = frames.strides(1);
+  recording.column_stride = frames.strides(2);
+  recording.num_frames = static_cast<int>(count);
+  recording.height = static_cast<int>(height);
+  recording.width = static_cast<int>(width);
 }
 
+// After SetFrames: the length is checked against the frames before anything is copied.
 void SetFrameTimes(py::handle times_object, RecordingInput* input) {
-  input->frame_times = CheckedArray<double>(times_object, 1, "frame_times");
+  const py::array times_array = CheckedDtypeAndRank<double>(times_object, 1, "frame_times");
+  if (times_array.shape(0) != input->recording.num_frames) {
+    throw InvalidArgumentError(
+        "frame_times must hold one time per frame: " + std::to_string(input->recording.num_frames) +
+        " frames, " + std::to_string(times_array.shape(0)) + " times");
+  }
+  input->frame_times = CheckedArray<double>(times_array, 1, "frame_times");
   const auto times = input->frame_times.unchecked<1>();
   for (py::ssize_t i = 0; i < times.shape(0); ++i) {
     input->recording.frame_t_ns.push_back(
@@ -188,14 +171,15 @@ void SetFrameTimes(py::handle times_object, RecordingInput* input) {
 // exposures: None, or frames × 2 (begin, end) in seconds with NaN rows for frames without one.
 void SetExposures(py::handle exposures_object, RecordingInput* input) {
   if (exposures_object.is_none()) return;
-  const auto exposures = CheckedArray<double>(exposures_object, 2, "exposures");
+  const py::array unchecked = CheckedDtypeAndRank<double>(exposures_object, 2, "exposures");
   RecordingArrays& recording = input->recording;
-  if (exposures.shape(0) != recording.num_frames || exposures.shape(1) != 2) {
+  if (unchecked.shape(0) != recording.num_frames || unchecked.shape(1) != 2) {
     throw InvalidArgumentError(
         "exposures must be a frames x 2 array (begin, end in seconds; NaN "
         "where a frame has none): " +
         std::to_string(recording.num_frames) + " x 2 here");
   }
+  const auto exposures = CheckedArray<double>(unchecked, 2, "exposures");
   const auto view = exposures.unchecked<2>();
   for (int i = 0; i < recording.num_frames; ++i) {
     const bool known = !std::isnan(view(i, 0)) || !std::isnan(view(i, 1));
@@ -222,21 +206,80 @@ void SetEvents(py::handle events_object, RecordingInput* input) {
                                  "': expected arrays 't', 'x', 'y' and 'p'");
     }
   }
-  input->event_t = CheckedArray<double>(events["t"], 1, "events['t']");
-  input->event_x = CheckedArray<uint16_t>(events["x"], 1, "events['x']");
-  input->event_y = CheckedArray<uint16_t>(events["y"], 1, "events['y']");
-  input->event_p = CheckedArray<int8_t>(events["p"], 1, "events['p']");
+  // Read where they lie, through their strides (StridedArray): no layout costs a copy.
+  input->event_t = CheckedDtypeAndRank<double>(events["t"], 1, "events['t']");
+  input->event_x = CheckedDtypeAndRank<uint16_t>(events["x"], 1, "events['x']");
+  input->event_y = CheckedDtypeAndRank<uint16_t>(events["y"], 1, "events['y']");
+  input->event_p = CheckedDtypeAndRank<int8_t>(events["p"], 1, "events['p']");
   const py::ssize_t count = input->event_t.shape(0);
   if (input->event_x.shape(0) != count || input->event_y.shape(0) != count ||
       input->event_p.shape(0) != count) {
     throw InvalidArgumentError("events['t'], ['x'], ['y'] and ['p'] must have the same length");
   }
   RecordingArrays& recording = input->recording;
-  recording.event_t_s = input->event_t.data();
-  recording.event_x = input->event_x.data();
-  recording.event_y = input->event_y.data();
-  recording.event_polarity = input->event_p.data();
+  if (count > kMaxArrayEvents) {
+    throw InvalidArgumentError("events holds " + std::to_string(count) + " events, more than the " +
+                               std::to_string(kMaxArrayEvents) + " an array recording may hold");
+  }
+  recording.event_t_s = Strided<double>(input->event_t);
+  recording.event_x = Strided<uint16_t>(input->event_x);
+  recording.event_y = Strided<uint16_t>(input->event_y);
+  recording.event_polarity = Strided<int8_t>(input->event_p);
   recording.num_events = static_cast<size_t>(count);
+}
+
+// How often the calling thread looks for a signal while a job runs.
+constexpr auto kSignalPollInterval = std::chrono::milliseconds(20);
+
+// Runs `job` without the GIL on a thread of its own, while the calling thread looks for a
+// signal every kSignalPollInterval. Python runs its signal handlers only in the main thread,
+// between bytecodes: a job that held the calling thread would keep Ctrl-C waiting until it
+// ended. When a handler raises (KeyboardInterrupt on SIGINT), `cancel` is set, and the job
+// stops at its next check (a solver iteration, a window, a frame); the handler's exception is
+// raised once the job has ended, since the job reads the caller's arrays and writes staging
+// folders that must not be released under it. `job` must not touch Python objects.
+void RunInterruptibly(const std::function<void(const std::atomic<bool>& cancel)>& job) {
+  std::atomic<bool> cancel(false);
+  std::mutex mutex;
+  std::condition_variable finished_changed;
+  bool finished = false;
+  std::exception_ptr job_error;
+  PyObject* signal_type = nullptr;
+  PyObject* signal_value = nullptr;
+  PyObject* signal_traceback = nullptr;
+  {
+    py::gil_scoped_release release;
+    std::thread worker([&] {
+      try {
+        job(cancel);
+      } catch (...) {
+        job_error = std::current_exception();
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      finished = true;
+      finished_changed.notify_all();
+    });
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!finished_changed.wait_for(lock, kSignalPollInterval, [&] { return finished; })) {
+      if (cancel) continue;
+      lock.unlock();
+      {
+        const py::gil_scoped_acquire acquire;
+        if (PyErr_CheckSignals() != 0) {
+          PyErr_Fetch(&signal_type, &signal_value, &signal_traceback);
+          cancel = true;
+        }
+      }
+      lock.lock();
+    }
+    lock.unlock();
+    worker.join();
+  }
+  if (signal_type != nullptr) {
+    PyErr_Restore(signal_type, signal_value, signal_traceback);
+    throw py::error_already_set();
+  }
+  if (job_error) std::rethrow_exception(job_error);
 }
 
 // A NumPy array over `values`, which it keeps alive: no copy.
@@ -307,15 +350,15 @@ py::dict ReadArrays(const std::string& path) {
   }
   double* image_data = images.mutable_data();
   EventStream events(source->width(), source->height());
-  {
-    py::gil_scoped_release release;
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
     const size_t pixels = static_cast<size_t>(source->width()) * source->height();
     for (int i = 0; i < num_frames; ++i) {
+      if (cancel) throw InterruptedError();
       const Image image = source->ReadImage(i);
       std::copy(image.data(), image.data() + pixels, image_data + i * pixels);
     }
     if (source->has_events()) events = source->ReadAllEvents();
-  }
+  });
   py::dict result;
   result["path"] = path;
   result["width"] = source->width();
@@ -366,12 +409,18 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   SetEvents(events, &input);
   ReconstructResult result;
   std::string summary;
-  std::atomic<bool> interrupt(false);
-  request.method.interrupt = &interrupt;
-  RunInterruptible(&interrupt, [&] {
-    CheckRecordingArrays(input.recording, "frames", "events");
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
+    CheckRecordingArrays(input.recording, "frames", "events", &cancel);
     const ArraySource source(input.recording, kArraysLabel);
-    result = RunReconstruction(request, source);
+    // An interrupted solve returns its current iterate; the next stage, or the check after the
+    // job, turns it into InterruptedError, so that it is never returned as a result.
+    ReconstructRequest interruptible = request;
+    interruptible.method.interrupt = &cancel;
+    interruptible.stage = [&cancel](const char*) {
+      if (cancel) throw InterruptedError();
+    };
+    result = RunReconstruction(interruptible, source);
+    if (cancel) throw InterruptedError();
     summary = SummaryJson(request, result);
   });
   py::dict output;
@@ -391,10 +440,9 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
   SetFrames(frames, &input);
   SetFrameTimes(frame_times, &input);
   EventStream events;
-  {
-    py::gil_scoped_release release;
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
     const RecordingArrays& recording = input.recording;
-    CheckRecordingArrays(recording, "frames", "events");
+    CheckRecordingArrays(recording, "frames", "events", &cancel);
     if (recording.num_frames < 2) {
       throw InvalidArgumentError("simulate needs at least 2 frames (" +
                                  std::to_string(recording.num_frames) + " found)");
@@ -402,16 +450,17 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
     const ArraySource source(recording, kArraysLabel);
     Video video;
     for (int i = 0; i < recording.num_frames; ++i) {
+      if (cancel) throw InterruptedError();
       video.AppendFrame(source.ReadImage(i), recording.frame_t_ns[i]);
     }
     events = SimulateEvents(video, simulator);
-  }
+  });
   return EventsDict(std::move(events));
 }
 
 // evfs.video: `evfs video` without MPI, into a folder through the same OutputTarget (so the
 // same refusals and the same atomic replacement). Unlike the command line it runs in this
-// process: a signal leaves the staging folder, and the resumable work folder, behind.
+// process; Ctrl-C stops it through RunInterruptibly.
 py::dict VideoFromPath(const std::string& data, const std::string& out, const py::int_& first,
                        const py::int_& last, double fps, const py::int_& jobs,
                        const py::int_& frame_step, bool predict_tail, bool preview, bool report,
@@ -449,11 +498,14 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   output.inputs = {data};
   VideoResult result;
   std::string path;
-  std::atomic<bool> interrupt(false);
-  request.method.interrupt = &interrupt;
-  RunInterruptible(&interrupt, [&] {
+  // Interrupted, the staging folder goes with the OutputTarget (nothing is committed) and the
+  // work folder stays for resume, as after the command line's Ctrl-C.
+  RunInterruptibly([&](const std::atomic<bool>& cancel) {
+    VideoRequest interruptible = request;
+    interruptible.method.interrupt = &cancel;
     OutputTarget target(output);
-    result = RunVideo(request, target.path(), target.staging());
+    result = RunVideo(interruptible, target.path(), target.staging());
+    if (cancel) throw InterruptedError();
     target.Commit();
     RemoveVideoWorkFolder(target.path());
     path = target.path();
@@ -490,7 +542,9 @@ PYBIND11_MODULE(evfs, m) {
       "read(path) loads a recording; reconstruct(...) synthesises latent frames from frames and "
       "events; simulate(...) makes events from frames. Options are the command line's flags "
       "(reconstruct_defaults(), simulate_defaults()). User errors raise ValueError with the "
-      "command line's message, a failed solve RuntimeError.";
+      "command line's message, a failed solve RuntimeError, an input too large for memory "
+      "MemoryError. Ctrl-C stops a running call with KeyboardInterrupt and keeps nothing it "
+      "was writing (video keeps its work folder for resume=True).";
   m.attr("__version__") = evfs::kVersion;
 
   py::register_exception_translator([](std::exception_ptr error) {

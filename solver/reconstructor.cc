@@ -171,7 +171,8 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
 
 // One Levenberg–Marquardt solve of `solve_options`' objective from result->video, which it
 // updates; adds its times and iterations to result->summary and sets the rest from this solve.
-void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_options,
+// Returns whether `callback` stopped the solve.
+bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_options,
                    const IterationCallback& callback, Reconstruction* result) {
   ReconstructionSummary& summary = result->summary;
   const int threads = std::max(1, solve_options.solver.num_threads);
@@ -296,7 +297,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
     summary.skipped_reason = summary.stopped_early.empty()
                                  ? "no unknowns: no pixel is active"
                                  : "stopped early before the solve: " + summary.stopped_early;
-    return;
+    return adapter && adapter->stopped();
   }
   summary.iterations += iterations;
   if (summary.ceres.termination_type == ceres::FAILURE) {
@@ -308,6 +309,7 @@ void BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
   plan.layout().Expand(&result->video);
   summary.ramped_steps =
       RampSteps(scene, plan.layout(), solve_options.step_ramp_px, &result->video);
+  return adapter && adapter->stopped();
 }
 
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
@@ -343,8 +345,9 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
     // Steps are ramped once, on the answer; with a prior (plug & play's x-update) the solve's
     // answer is the minimiser it asked for.
     if (i + 1 < scales.size() || options.objective.prior_weight != 0.0) stage.step_ramp_px = 0.0;
-    BuildAndSolve(scene, stage, callback, &result);
-    if (!summary.solved || !summary.stopped_early.empty()) break;
+    const bool stopped = BuildAndSolve(scene, stage, callback, &result);
+    // A callback or a stop condition that ends the solve ends it whole: no later scale is built.
+    if (stopped || !summary.solved || !summary.stopped_early.empty()) break;
   }
   // With a prior (plug & play's x-update) the solve's answer is the minimiser it asked for.
   if (options.quiet_blend_fraction > 0.0 && options.objective.prior_weight == 0.0 &&

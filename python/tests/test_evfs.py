@@ -8,6 +8,7 @@ files with what the module returns.
 import glob
 import os
 import re
+import signal
 import subprocess
 import sys
 import threading
@@ -532,65 +533,187 @@ def test_video_identical_to_cli(demo, tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------
-# What may not kill the interpreter, and Ctrl-C
+# No array may crash the interpreter: layouts, sizes, counts
 
 
-def test_broadcast_and_strided_views_are_bounded_before_any_copy(small):
-    times = np.array([0.0, 0.04])
-    events = {"t": np.array([0.01]), "x": np.array([1], np.uint16), "y": np.array([1], np.uint16),
-              "p": np.array([1], np.int8)}
-    # A zero-stride view of 8 bytes that claims 6.4 GB: refused from its shape, nothing copied.
+def test_zero_stride_view_of_a_huge_shape_is_refused_before_it_is_read(small):
     huge = np.broadcast_to(0.5, (2, 20000, 20000))
-    with pytest.raises(ValueError, match=r"20000x20000: more than the 67108864 pixels"):
-        evfs.reconstruct(huge, times, events)
-    with pytest.raises(ValueError, match="more than the 67108864 pixels"):
-        evfs.simulate(np.broadcast_to(np.float32(0.5), (2, 1, 70000)), times)
-    # A small broadcast or reversed view is copied and reconstructs as its contiguous copy does.
-    view = np.broadcast_to(small["frames"][:1], small["frames"].shape)[:, ::-1, :]
-    copy = np.ascontiguousarray(view)
-    a = reconstruct(small, frames=view, options={"solver": "copy"})
-    b = reconstruct(small, frames=copy, options={"solver": "copy"})
-    np.testing.assert_array_equal(a["frames"], b["frames"])
+    with pytest.raises(ValueError, match=r"20000x20000 pixels are larger than the 67108864"):
+        reconstruct(small, frames=huge, frame_times=np.array([0.0, 0.1]))
+    with pytest.raises(ValueError, match=r"more than the 1000000 an array recording may hold"):
+        reconstruct(small, frames=np.broadcast_to(0.5, (2**31, 1, 1)),
+                    frame_times=np.array([0.0, 0.1]))
+    with pytest.raises(ValueError, match="one time per frame: 2 frames, 1000000000 times"):
+        reconstruct(small, frames=np.broadcast_to(0.5, (2, 4, 4)),
+                    frame_times=np.broadcast_to(0.0, (10**9,)))
+    events = dict(small["events"], t=np.broadcast_to(0.0, (2**40,)))
+    with pytest.raises(ValueError, match="must have the same length"):
+        reconstruct(small, events=events)
 
 
-def interrupt_after(seconds):
-    """SIGINT to this process after `seconds`, as Ctrl-C sends it; returns the timer."""
-    import signal
+# A process under a 4 GB address-space limit (as a shared machine or a batch scheduler sets one)
+# must end every call with an exception, never a signal.
+MEMORY_LIMITED_SCRIPT = r"""
+import resource, sys
+import numpy as np
+import evfs
+limit = 4_000_000 * 1024
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+times = np.array([0.0, 0.1])
+events = {"t": np.zeros(0), "x": np.zeros(0, np.uint16), "y": np.zeros(0, np.uint16),
+          "p": np.zeros(0, np.int8)}
+for shape in [(2, 20000, 20000), (2, 15000, 15000), (2, 8192, 8192)]:
+    try:
+        evfs.reconstruct(np.broadcast_to(0.5, shape), times, events, options={"solver": "copy"})
+        print(shape, "returned")
+    except (ValueError, MemoryError) as error:
+        print(shape, type(error).__name__)
+"""
 
-    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+
+def child_env():
+    """This environment, with the folder of the evfs module under test first on PYTHONPATH."""
+    module_folder = os.path.dirname(os.path.abspath(evfs.__file__))
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [module_folder] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+
+
+def test_huge_frames_under_an_address_space_limit_raise(tmp_path):
+    done = subprocess.run([sys.executable, "-c", MEMORY_LIMITED_SCRIPT], capture_output=True,
+                          text=True, timeout=600, cwd=tmp_path, env=child_env())
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0] == "(2, 20000, 20000) ValueError"
+    assert lines[1] == "(2, 15000, 15000) ValueError"
+    # Within the sensor cap: refused by the latent-voxel cap, or out of memory, or solved.
+    assert lines[2].split(")")[1].strip() in ("returned", "MemoryError", "ValueError")
+
+
+def test_any_layout_gives_the_contiguous_result(small):
+    """Frames and events read through their strides: reversed, strided, unaligned, broadcast
+    and Fortran-ordered views give what their contiguous copies give."""
+    options = {"solver": "copy"}
+    expected = reconstruct(small, options=options)["frames"]
+    frames = small["frames"]
+
+    def unaligned(array):
+        raw = np.zeros(array.nbytes + 1, dtype=np.uint8)
+        view = raw[1:].view(array.dtype).reshape(array.shape)
+        view[...] = array
+        assert not view.flags.aligned
+        return view
+
+    reversed_frames = frames[::-1].copy()[::-1]
+    assert reversed_frames.strides[0] < 0
+    for layout in (reversed_frames, np.asfortranarray(frames), unaligned(frames),
+                   np.repeat(frames, 2, axis=2)[:, :, ::2]):
+        np.testing.assert_array_equal(reconstruct(small, frames=layout, options=options)["frames"],
+                                      expected)
+    events = {key: unaligned(value) if value.dtype.itemsize > 1 else
+              np.repeat(value, 3)[::3] for key, value in small["events"].items()}
+    np.testing.assert_array_equal(reconstruct(small, events=events, options=options)["frames"],
+                                  expected)
+    # A zero-stride frame stack: every frame the same grey.
+    grey = np.broadcast_to(0.5, frames.shape)
+    np.testing.assert_array_equal(
+        reconstruct(small, frames=grey, options=options)["frames"],
+        reconstruct(small, frames=np.full(frames.shape, 0.5), options=options)["frames"])
+
+
+def test_byte_swapped_and_non_finite_arrays_are_refused(small):
+    with pytest.raises(ValueError, match="frames must be a 3-D float32 or float64 array"):
+        reconstruct(small, frames=small["frames"].astype(">f8"))
+    with pytest.raises(ValueError, match=r"events\['t'\] must be a 1-D float64 array, not >f8"):
+        reconstruct(small, events=dict(small["events"], t=small["events"]["t"].astype(">f8")))
+    for bad in (np.nan, np.inf, -np.inf):
+        frames = small["frames"].copy()
+        frames[0, 0, 0] = bad
+        with pytest.raises(ValueError, match=r"intensities in \[0, 1\]: \[0, 0, 0\]"):
+            reconstruct(small, frames=frames)
+        times = small["frame_times"].copy()
+        times[1] = bad
+        with pytest.raises(ValueError, match=r"frame_times\[1\]"):
+            reconstruct(small, frame_times=times)
+        t = small["events"]["t"].copy()
+        t[2] = bad
+        with pytest.raises(ValueError, match=r"events\['t'\]\[2\]"):
+            reconstruct(small, events=dict(small["events"], t=t))
+    with pytest.raises(ValueError, match="at least one frame of at least 1x1 pixels"):
+        reconstruct(small, frames=np.zeros((2, 0, 5)))
+
+
+# ---------------------------------------------------------------------------------------------
+# Ctrl-C: KeyboardInterrupt within a second or two, nothing half-written
+
+# From SIGINT to KeyboardInterrupt: one Adam iteration (milliseconds) or one window's stop, plus
+# the poll interval, on a machine shared with other builds.
+INTERRUPT_LATENCY_S = 2.0
+
+
+def interrupt_after(delay_s):
+    """Sends this process SIGINT after `delay_s`; returns a list that receives the send time."""
+    sent = []
+
+    def fire():
+        sent.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+    timer = threading.Timer(delay_s, fire)
     timer.start()
-    return timer
+    return sent, timer
 
 
-def test_ctrl_c_stops_reconstruct_within_a_second(small):
-    # A solve of minutes: Adam for a million steps.
-    options = {"solver": "adam", "adam_iterations": 1000000, "threads": 1}
-    timer = interrupt_after(0.5)
-    begin = time.perf_counter()
+def test_ctrl_c_stops_reconstruct(small):
+    # Adam for far longer than the test waits: only the interrupt ends it in time.
+    options = {"solver": "adam", "adam_iterations": 10**7, "denoise": "none"}
+    sent, timer = interrupt_after(1.0)
     try:
         with pytest.raises(KeyboardInterrupt):
             reconstruct(small, options=options)
+        raised = time.perf_counter()
     finally:
         timer.cancel()
-    elapsed = time.perf_counter() - begin
-    assert elapsed < 0.5 + 1.0, f"KeyboardInterrupt came {elapsed - 0.5:.2f} s after the signal"
+    assert sent, "the solve ended before the signal"
+    assert raised - sent[0] < INTERRUPT_LATENCY_S
     # The module is usable afterwards.
-    assert reconstruct(small, options={"solver": "copy"})["frames"].shape[1:] == \
-        small["frames"].shape[1:]
+    assert reconstruct(small, options={"solver": "copy"})["frames"].shape[0] > 0
 
 
-def test_ctrl_c_stops_video_and_leaves_no_output(demo, tmp_path):
-    out = tmp_path / "video"
-    options = {"solver": "adam", "adam_iterations": 1000000}
-    timer = interrupt_after(0.5)
-    begin = time.perf_counter()
+def test_ctrl_c_stops_reconstruct_of_the_shared_cups_deblur():
+    data = evfs.read(shared_data("eslnet_cups_blur"))
+    sent, timer = interrupt_after(2.0)
     try:
         with pytest.raises(KeyboardInterrupt):
-            evfs.video(str(demo / "data"), str(out), fps=100, jobs=1, options=options)
+            evfs.reconstruct(data["frames"], data["frame_times"], data["events"], mode="deblur",
+                             exposures=data["exposures"],
+                             options={"solver": "adam", "adam_iterations": 10**7})
+        raised = time.perf_counter()
     finally:
         timer.cancel()
-    elapsed = time.perf_counter() - begin
-    assert elapsed < 0.5 + 1.0, f"KeyboardInterrupt came {elapsed - 0.5:.2f} s after the signal"
-    # No output and no staging folder: only the work folder that resume=True reuses.
+    assert sent and raised - sent[0] < INTERRUPT_LATENCY_S
+
+
+def test_ctrl_c_stops_video_and_commits_nothing(demo, tmp_path):
+    out = tmp_path / "video"
+    options = {"solver": "adam", "adam_iterations": 10**7, "denoise": "none"}
+    sent, timer = interrupt_after(1.5)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            evfs.video(str(demo / "data"), str(out), fps=400, jobs=2, options=options)
+        raised = time.perf_counter()
+    finally:
+        timer.cancel()
+    assert sent and raised - sent[0] < INTERRUPT_LATENCY_S
+    assert not out.exists()
     left = sorted(p.name for p in tmp_path.iterdir())
+    # Only the work folder stays (for resume=True), as after the command line's Ctrl-C; no
+    # staging folder.
     assert left in ([], [".video.evfs-video-work"]), left
+    assert not any("evfs-tmp" in name for name in left)
+
+
+def test_video_fps_beyond_one_per_nanosecond_is_refused(demo, tmp_path):
+    # Output times are whole nanoseconds: a faster rate's step rounds to zero, and the output
+    # clock would never advance.
+    with pytest.raises(ValueError, match="--fps must be at most 1e9 frames per second"):
+        evfs.video(str(demo / "data"), str(tmp_path / "v"), fps=1e308)
+    assert not any(tmp_path.iterdir())

@@ -147,6 +147,24 @@ TEST(Reconstructor, ContinuationOnTheSmoothingScaleEndsOnTheObjectivesOwn) {
   EXPECT_NE(error.find("smoothing_continuation"), std::string::npos) << error;
 }
 
+// A callback that stops the solve stops it whole: with a smoothing continuation, no later scale
+// is built and solved (a caller that stops on Ctrl-C would otherwise wait for every scale's
+// build and first iteration).
+TEST(Reconstructor, CallbackThatStopsEndsTheContinuation) {
+  const test::SyntheticRecording recording;
+  const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                             recording.events, BinningOptions());
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  options.smoothing_continuation = {0.3, 0.1};
+  int calls = 0;
+  Reconstruct(scene, options, nullptr, [&](const SolverIteration&) {
+    ++calls;
+    return false;
+  });
+  EXPECT_EQ(calls, 1);
+}
+
 // A start Ceres cannot evaluate (NaN intensities) ends its solve with FAILURE: a solver
 // failure, not an invalid argument of the user's.
 TEST(Reconstructor, CeresFailureIsASolverError) {
