@@ -236,6 +236,20 @@ TEST(EvfsLimits, MaxTimeBoundsEveryIterativeSolve) {
   }
 }
 
+// --fps is bounded by the memory its resampled frames take, not only by their count: the cups
+// deblur (346x260) at 20 kHz would hold 3 GB, and is refused before anything is solved.
+TEST(EvfsLimits, FpsBeyondTheOutputMemoryIsAUserError) {
+  EVFS_REQUIRE_SHARED_DATA(data);
+  const std::string scratch = test::ScratchDir("limits_fps_memory");
+  const std::string cups = data + "/eslnet_cups_blur";
+  ExpectUserError(RunLimited("reconstruct --data=" + cups +
+                             " --mode=deblur --first=1 --fps=20000 --out=" + scratch + "/r"),
+                  "--fps=20000 would resample the 0.104 s window to 2080 frames of 346x260",
+                  scratch + "/r");
+  ExpectUserError(RunLimited("video --data=" + cups + " --fps=20000 --out=" + scratch + "/v"),
+                  "lower --fps", scratch + "/v");
+}
+
 // --jobs beyond the windows is lowered, and said so, rather than starting idle threads.
 TEST(EvfsLimits, VideoJobsBeyondTheWindowsAreLowered) {
   const std::string scratch = test::ScratchDir("limits_jobs");
