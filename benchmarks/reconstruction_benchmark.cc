@@ -37,8 +37,7 @@
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
 DEFINE_string(cases, "slider,shapes,cups,clips", "Comma-separated cases to run.");
-DEFINE_string(clips, EVFS_BENCHMARK_CLIPS,
-              "Ground-truth clips for the simulated-event cases.");
+DEFINE_string(clips, EVFS_BENCHMARK_CLIPS, "Ground-truth clips for the simulated-event cases.");
 DEFINE_string(csv, "", "Also write the rows as CSV to this file.");
 DEFINE_string(denoise, "none",
               "The DAVIS cases' residual denoiser, as evfs reconstruct's --denoise: none (the "

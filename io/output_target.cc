@@ -438,6 +438,7 @@ OutputLock::OutputLock(const std::string& out_path) : path_(LockPath(out_path)) 
                        "cannot lock the output: its lock file keeps changing");
     }
   }
+  cleanup_ = std::make_unique<ScopedCleanupPath>(path_);
   const std::string pid = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
     // The process id only makes a refusal clearer; the lock holds without it.

@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "io/signal_cleanup.h"
+
 namespace evfs {
 
 class ScopedCleanupPath;
@@ -64,8 +66,9 @@ struct OutputOptions {
 /// the work folder beside it) at once. It is flock(2) on the file .NAME.evfs-lock beside the
 /// output, which holds the holder's process id: the kernel releases it when the process ends in
 /// any way (SIGKILL included), so a lock file left by a killed run never blocks; the holder
-/// removes the file when it lets go. The lock file lies beside OUT, never inside it, so it is no
-/// part of an output.
+/// removes the file when it lets go, and a worker process registers it for cleanup, so that its
+/// parent removes it when the worker dies (io/signal_cleanup.h). The lock file lies beside OUT,
+/// never inside it, so it is no part of an output.
 class OutputLock {
  public:
   /// Takes the lock on `out_path` without waiting: throws InvalidArgumentError, naming the output
@@ -86,6 +89,7 @@ class OutputLock {
  private:
   std::string path_;
   int fd_ = -1;
+  std::unique_ptr<ScopedCleanupPath> cleanup_;
 };
 
 class OutputTarget {

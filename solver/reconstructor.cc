@@ -264,13 +264,17 @@ bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
       // Largest first, each worker taking the next part as it becomes free; Ceres' own threads
       // split what remains.
       const int workers = std::min<int>(threads, static_cast<int>(parts.size()));
+      std::vector<char> skipped(parts.size(), 0);
       ParallelForEach(static_cast<int>(parts.size()), workers, [&](int i) {
-        if (stop.Reached()) return;  // left at its start, below
+        if (stop.Reached()) {
+          skipped[i] = 1;  // left at its start, below
+          return;
+        }
         ceres::Solve(part_options(i, std::max(1, threads / workers)), &parts[i]->problem(),
                      &part_summaries[i]);
       });
       for (size_t i = 0; i < parts.size(); ++i) {
-        if (!part_summaries[i].iterations.empty()) continue;
+        if (!skipped[i]) continue;
         const double cost = InitialCost(&parts[i]->problem());
         part_summaries[i].termination_type = ceres::USER_SUCCESS;
         part_summaries[i].message = "not solved: stopped early";
@@ -285,7 +289,8 @@ bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
     }
   }
   if (stop.Reached()) summary.stopped_early = stop.Reason();
-  if (!summary.stopped_early.empty() && summary.ceres.iterations.empty()) {
+  if (!summary.stopped_early.empty() && summary.ceres.iterations.empty() &&
+      summary.ceres.termination_type != ceres::FAILURE) {
     // Stopped before any part was solved: nothing failed.
     summary.ceres.termination_type = ceres::USER_SUCCESS;
     summary.ceres.message = std::string("stopped early: ") + summary.stopped_early;
