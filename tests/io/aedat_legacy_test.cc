@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -35,7 +36,10 @@ std::string EncodedFolder(const std::string& data_dir, const std::string& name) 
   static std::map<std::string, std::string> encoded;
   auto found = encoded.find(name);
   if (found != encoded.end()) return found->second;
-  const std::string out = test::ScratchDir("aedat_legacy_" + name);
+  // A folder per test: ctest runs the tests of this suite in parallel processes.
+  std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::replace(test_name.begin(), test_name.end(), '/', '_');
+  const std::string out = test::ScratchDir("aedat_legacy_" + name + "_" + test_name);
   const std::string command = "/usr/bin/python3 " + std::string(EVFS_TEST_SOURCE_DIR) +
                               "/aedat_legacy_encode.py " + data_dir + "/" + name + " " + out;
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
