@@ -325,15 +325,9 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
 
   // Nothing has been read or computed yet: create the parents and the staging path now, so an
   // output that cannot be written fails before the work.
-  const auto remove_created_parents = [this] {
-    std::error_code ignored;
-    for (auto created = created_parents_.rbegin(); created != created_parents_.rend(); ++created) {
-      fs::remove(*created, ignored);  // only while empty
-    }
-  };
   for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
     if (!fs::create_directory(*it, error) || error) {
-      remove_created_parents();
+      RemoveCreatedParents();
       Unwritable(*it, "cannot create the folder (" + error.message() + ")");
     }
     created_parents_.push_back(it->string());
@@ -343,7 +337,7 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
   try {
     lock_ = std::make_unique<OutputLock>(path_);
   } catch (...) {
-    remove_created_parents();
+    RemoveCreatedParents();
     throw;
   }
   RemoveLeftovers();
@@ -374,7 +368,7 @@ OutputTarget::OutputTarget(OutputOptions options) : options_(std::move(options))
     staging_.clear();
     const std::string reason = std::generic_category().message(open_errno);
     lock_.reset();
-    remove_created_parents();
+    RemoveCreatedParents();
     Unwritable(path, "cannot create the output (" + reason + ")");
   }
 }
@@ -387,9 +381,13 @@ OutputTarget::~OutputTarget() {
     cleanup_.reset();
   }
   lock_.reset();  // its file lies in the parents
-  if (!remove) return;
-  for (auto it = created_parents_.rbegin(); it != created_parents_.rend(); ++it) {
-    fs::remove(*it, error);  // only while empty
+  if (remove) RemoveCreatedParents();
+}
+
+void OutputTarget::RemoveCreatedParents() const {
+  std::error_code ignored;
+  for (auto created = created_parents_.rbegin(); created != created_parents_.rend(); ++created) {
+    fs::remove(*created, ignored);  // only while empty
   }
 }
 
@@ -438,11 +436,33 @@ OutputLock::OutputLock(const std::string& out_path) : path_(LockPath(out_path)) 
                        "cannot lock the output: its lock file keeps changing");
     }
   }
+  RefuseForeignLockFile(out_path);
   cleanup_ = std::make_unique<ScopedCleanupPath>(path_);
   const std::string pid = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
     // The process id only makes a refusal clearer; the lock holds without it.
   }
+}
+
+void OutputLock::RefuseForeignLockFile(const std::string& out_path) {
+  // The lock file is evfs' own only when it is a plain file that is empty (just created) or
+  // holds a process id (left by a run that died): anything else is a user's file of that name,
+  // which the run would overwrite and delete.
+  struct stat held = {};
+  char content[kMaxLockFileBytes + 1] = {0};
+  const ssize_t read_bytes = ::pread(fd_, content, sizeof(content), 0);
+  bool ours = ::fstat(fd_, &held) == 0 && S_ISREG(held.st_mode) && read_bytes >= 0 &&
+              read_bytes <= kMaxLockFileBytes;
+  for (ssize_t i = 0; ours && i < read_bytes; ++i) {
+    const unsigned char c = static_cast<unsigned char>(content[i]);
+    ours = std::isdigit(c) || (c == '\n' && i == read_bytes - 1);
+  }
+  if (ours) return;
+  ::close(fd_);
+  fd_ = -1;
+  throw InvalidArgumentError("--out=" + Normalized(out_path).string() + " needs the name " + path_ +
+                             " for its lock, and a file that is not evfs' is there; " +
+                             "move it away, or choose another --out");
 }
 
 OutputLock::~OutputLock() {

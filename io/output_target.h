@@ -73,7 +73,9 @@ class OutputLock {
  public:
   /// Takes the lock on `out_path` without waiting: throws InvalidArgumentError, naming the output
   /// and the holder's process id, when another process holds it, and InputError(kUnwritable)
-  /// when the lock file cannot be created. The folder holding `out_path` must exist.
+  /// when the lock file cannot be created. A file of the lock's name that evfs did not write
+  /// (not empty and not a process id) is left alone and refused with InvalidArgumentError. The
+  /// folder holding `out_path` must exist.
   explicit OutputLock(const std::string& out_path);
   /// Removes the lock file and releases the lock.
   ~OutputLock();
@@ -87,6 +89,11 @@ class OutputLock {
   static std::string LockPath(const std::string& out_path);
 
  private:
+  /// The longest lock file evfs writes: a process id and a newline.
+  static constexpr int kMaxLockFileBytes = 24;
+  /// Throws InvalidArgumentError (closing fd_) unless the locked file is evfs' own.
+  void RefuseForeignLockFile(const std::string& out_path);
+
   std::string path_;
   int fd_ = -1;
   std::unique_ptr<ScopedCleanupPath> cleanup_;
@@ -124,6 +131,8 @@ class OutputTarget {
   void RemoveLeftovers() const;
   // Removes an earlier output once replaced; warns when it cannot.
   void RemoveReplaced(const std::filesystem::path& replaced) const;
+  // Removes the parent folders this target created, deepest first, each only while empty.
+  void RemoveCreatedParents() const;
   void Warn(const std::string& message) const;
 
   OutputOptions options_;

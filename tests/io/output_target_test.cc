@@ -544,6 +544,42 @@ TEST(OutputLockTest, TheLockFileIsNoPartOfTheOutput) {
   EXPECT_EQ(sandbox.Others(out, "").size(), 1u);              // the marker
 }
 
+// A user's file that happens to carry the lock's name is not evfs' to overwrite or delete:
+// the run is refused and the file is left as it was. A stale lock of a run that died (a
+// process id) and an empty file are evfs' own and are taken over.
+TEST(OutputLockTest, AForeignFileOfTheLocksNameSurvives) {
+  const Sandbox sandbox("lock_foreign");
+  const fs::path out = sandbox.root / "out";
+  const std::string lock_path = OutputLock::LockPath(out.string());
+  for (const std::string& content :
+       {std::string("my notes\n"), std::string("12345\n12345\n"), std::string(100, '7')}) {
+    test::WriteFile(lock_path, content);
+    try {
+      OutputTarget target(sandbox.Options(out));
+      ADD_FAILURE() << "a run took a lock file holding '" << content << "'";
+    } catch (const InvalidArgumentError& error) {
+      EXPECT_NE(std::string(error.what()).find("not evfs'"), std::string::npos) << error.what();
+    }
+    EXPECT_EQ(test::ReadFile(lock_path), content);
+    EXPECT_FALSE(fs::exists(out));
+  }
+  fs::remove(lock_path);
+  fs::create_directory(lock_path);
+  EXPECT_THROW(OutputTarget target(sandbox.Options(out)), std::exception);
+  EXPECT_TRUE(fs::is_directory(lock_path));
+  fs::remove(lock_path);
+
+  for (const std::string& content : {std::string(), std::string("4242\n")}) {
+    test::WriteFile(lock_path, content);
+    {
+      OutputTarget target(sandbox.Options(out));
+      target.Commit();
+    }
+    EXPECT_FALSE(fs::exists(lock_path));
+    fs::remove_all(out);
+  }
+}
+
 TEST(SignalCleanupTest, AReleasedPathIsNotRemoved) {
   const Sandbox sandbox("released");
   CleanupChannel channel;
