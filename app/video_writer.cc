@@ -1,6 +1,5 @@
 #include "app/video_writer.h"
 
-#include <dlfcn.h>
 #include <stdlib.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 
 #include "app/mp4_encoder_plugin.h"
 #include "core/error.h"
+#include "core/plugin.h"
 
 namespace evfs {
 namespace {
@@ -23,49 +23,20 @@ struct Mp4Plugin {
   EvfsMp4CloseFunction close = nullptr;
 };
 
-// Where the plug-in is looked for: $EVFS_PLUGIN_DIR, next to the binary that holds this code
-// and in the lib/evfs/ of its installation, the configured install folder, then where the build
-// tree made it.
-std::vector<std::filesystem::path> PluginCandidates() {
-  std::vector<std::filesystem::path> candidates;
-  if (const char* dir = getenv("EVFS_PLUGIN_DIR"); dir != nullptr && *dir != '\0') {
-    candidates.push_back(std::filesystem::path(dir) / EVFS_MP4_PLUGIN_FILE);
-  }
-  Dl_info info;
-  if (dladdr(reinterpret_cast<void*>(&PluginCandidates), &info) != 0 && info.dli_fname) {
-    const std::filesystem::path binary = std::filesystem::weakly_canonical(info.dli_fname);
-    candidates.push_back(binary.parent_path() / EVFS_MP4_PLUGIN_FILE);
-    candidates.push_back(binary.parent_path().parent_path() / EVFS_PLUGIN_INSTALL_SUBDIR /
-                         EVFS_MP4_PLUGIN_FILE);
-  }
-  candidates.push_back(std::filesystem::path(EVFS_PLUGIN_INSTALL_DIR) / EVFS_MP4_PLUGIN_FILE);
-  candidates.push_back(std::filesystem::path(EVFS_PLUGIN_BUILD_DIR) / EVFS_MP4_PLUGIN_FILE);
-  return candidates;
-}
-
 const Mp4Plugin& LoadMp4Plugin() {
   static Mp4Plugin plugin;
   static std::string error;
   static std::once_flag once;
   std::call_once(once, [] {
-    for (const std::filesystem::path& candidate : PluginCandidates()) {
-      std::error_code ignored;
-      if (!std::filesystem::is_regular_file(candidate, ignored)) continue;
-      void* module = dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
-      if (module == nullptr) {
-        const char* why = dlerror();
-        error = why != nullptr ? why : candidate.string();
-        continue;
-      }
-      plugin.open = reinterpret_cast<EvfsMp4OpenFunction>(dlsym(module, EVFS_MP4_OPEN_SYMBOL));
-      plugin.write = reinterpret_cast<EvfsMp4WriteFunction>(dlsym(module, EVFS_MP4_WRITE_SYMBOL));
-      plugin.close = reinterpret_cast<EvfsMp4CloseFunction>(dlsym(module, EVFS_MP4_CLOSE_SYMBOL));
-      if (plugin.open && plugin.write && plugin.close) return;
-      error = candidate.string() + " lacks the encoder's functions";
-      plugin = Mp4Plugin();
+    std::vector<void*> functions;
+    if (!LoadPlugin(EVFS_MP4_PLUGIN_FILE,
+                    {EVFS_MP4_OPEN_SYMBOL, EVFS_MP4_WRITE_SYMBOL, EVFS_MP4_CLOSE_SYMBOL},
+                    &functions, &error)) {
+      return;
     }
-    if (error.empty())
-      error = "no " EVFS_MP4_PLUGIN_FILE " next to evfs or in " EVFS_PLUGIN_INSTALL_DIR;
+    plugin.open = reinterpret_cast<EvfsMp4OpenFunction>(functions[0]);
+    plugin.write = reinterpret_cast<EvfsMp4WriteFunction>(functions[1]);
+    plugin.close = reinterpret_cast<EvfsMp4CloseFunction>(functions[2]);
   });
   if (plugin.open == nullptr) {
     throw Error("the MP4 encoder plug-in cannot be loaded (is evfs completely installed?): " +

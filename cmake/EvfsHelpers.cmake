@@ -97,3 +97,18 @@ function(evfs_add_benchmark name)
   evfs_add_executable(${name} SRCS ${ARG_SRCS} LINK_LIBS ${ARG_LINK_LIBS})
   target_compile_definitions(${name} PRIVATE EVFS_DATA_DIR="${EVFS_DATA_DIR}")
 endfunction()
+
+# evfs_add_plugin(NAME SRCS a.cc ... LINK_LIBS lib ...)
+#   A plug-in module that evfs opens with dlopen on first use (core/plugin.h), libNAME.so in the
+#   build tree's plugins/ folder and installed in lib/evfs/; only its C functions are visible.
+function(evfs_add_plugin name)
+  cmake_parse_arguments(ARG "" "" "SRCS;LINK_LIBS" ${ARGN})
+  add_library(${name} MODULE ${ARG_SRCS})
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR})
+  target_link_libraries(${name} PRIVATE ${ARG_LINK_LIBS})
+  set_target_properties(${name} PROPERTIES PREFIX "lib" OUTPUT_NAME ${name}
+                        CXX_VISIBILITY_PRESET hidden
+                        LIBRARY_OUTPUT_DIRECTORY "${EVFS_PLUGIN_OUTPUT_DIR}")
+  include(GNUInstallDirs)
+  install(TARGETS ${name} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/evfs)
+endfunction()

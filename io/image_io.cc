@@ -8,11 +8,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <vector>
 
 #include "core/error.h"
+#include "core/plugin.h"
 #include "io/decimal_seconds.h"
+#include "io/image_decoder_plugin.h"
+#include "io/png_codec.h"
 #include "io/text_file_writer.h"
 
 namespace evfs {
@@ -45,15 +49,37 @@ cv::Mat ToMat(const Image& image, int type, double max_value) {
 }
 
 void WritePng(const std::string& path, const cv::Mat& mat) {
-  bool written = false;
-  std::string why = "the encoder refused it (is the folder there, does the name end in .png?)";
-  try {
-    written = cv::imwrite(path, mat);
-  } catch (const cv::Exception& error) {
-    why = error.what();
-  }
-  if (!written)
+  std::string why;
+  if (!EncodePngGrey(path, mat, &why)) {
     throw InputError(InputError::Kind::kUnwritable, path, 0, "cannot write the image: " + why);
+  }
+}
+
+// A frame that is not a PNG file, through the image decoder plug-in; empty when it cannot be
+// decoded, with the reason in `why` when the plug-in itself is missing.
+cv::Mat DecodeOtherFormat(const std::string& path, std::string* why) {
+  static EvfsImageDecodeFunction decode = nullptr;
+  static EvfsImageFreeFunction release = nullptr;
+  static std::string load_error;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::vector<void*> functions;
+    if (LoadPlugin(EVFS_IMAGE_DECODER_PLUGIN_FILE,
+                   {EVFS_IMAGE_DECODE_SYMBOL, EVFS_IMAGE_FREE_SYMBOL}, &functions, &load_error)) {
+      decode = reinterpret_cast<EvfsImageDecodeFunction>(functions[0]);
+      release = reinterpret_cast<EvfsImageFreeFunction>(functions[1]);
+    }
+  });
+  if (decode == nullptr) {
+    *why = "the image decoder plug-in cannot be loaded (" + load_error + ")";
+    return cv::Mat();
+  }
+  int width = 0, height = 0, bits = 0;
+  void* pixels = nullptr;
+  if (decode(path.c_str(), &width, &height, &bits, &pixels) == 0) return cv::Mat();
+  cv::Mat mat = cv::Mat(height, width, bits == 16 ? CV_16UC1 : CV_8UC1, pixels).clone();
+  release(pixels);
+  return mat;
 }
 
 // Big-endian unsigned integer of `bytes` bytes at `data`.
@@ -163,15 +189,16 @@ Image ReadGreyImage(const std::string& path, int expected_width, int expected_he
     }
   }
   cv::Mat mat;
-  try {
-    // IMREAD_ANYDEPTH alone: grey, keeping 16 bits where the file has them.
-    mat = cv::imread(path, cv::IMREAD_ANYDEPTH);
-  } catch (const cv::Exception&) {
-    mat.release();
+  std::string why;
+  if (HasPngSignature(path)) {
+    if (!DecodePngGrey(path, &mat, &why)) mat.release();
+  } else {
+    mat = DecodeOtherFormat(path, &why);
   }
   if (mat.empty()) {
     throw InputError(InputError::Kind::kMissingFile, path, 0,
-                     "cannot decode the image (expected an 8- or 16-bit PNG)");
+                     "cannot decode the image (expected an 8- or 16-bit PNG" +
+                         (why.empty() ? std::string(")") : std::string("): ") + why));
   }
   switch (mat.depth()) {
     case CV_8U:

@@ -12,7 +12,7 @@ packages=(
   # The clang_format test (tests/CMakeLists.txt).
   clang-format
   libceres-dev libeigen3-dev libgoogle-glog-dev libgflags-dev
-  libopencv-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libopencv-dev libpng-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev
   # summary.json (app/reconstruct_job.cc).
   nlohmann-json3-dev
   # AEDAT 4 (io/aedat4/); the python3 modules decode the real samples independently in tests.

@@ -11,6 +11,7 @@
 #include <string>
 #include <thread>
 
+#include "core/error.h"
 #include "io/hdf5_io.h"
 #include "io/signal_cleanup.h"
 #include "tests/test_data.h"
@@ -74,23 +75,35 @@ TEST(RunInChildProcess, ACrashOutsideLibhdf5IsAnInternalErrorEvenReadingHdf5) {
 
 // The two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation
 // fault (tests/examples/data): the crash happens inside ScopedLibhdf5Read, so it is the file's.
+// Whether libhdf5 crashes on one of them depends on the process around it (the attribute file
+// crashed it while OpenCV's imgcodecs, and through it GDAL, were linked in); where it reads the
+// file instead, evfs must refuse the file cleanly. At least one file must crash, or the test
+// would prove nothing.
 TEST(RunInChildProcess, Libhdf5CrashingOnACorruptFileIsTheFilesFault) {
+  constexpr int kRefused = 3;
+  int crashed = 0;
   for (const char* name : {"fuzz_libhdf5_segv_cache_read.h5", "fuzz_libhdf5_segv_attribute.h5"}) {
     const std::string h5 = std::string(EVFS_TEST_SOURCE_DIR) + "/../examples/data/" + name;
     ::testing::internal::CaptureStderr();
     const int status = RunInChildProcess(
         [&h5] {
-          const Hdf5DataSource source(h5);
-          source.Summarize();
+          try {
+            const Hdf5DataSource source(h5);
+            source.Summarize();
+          } catch (const InputError&) {
+            return kRefused;
+          }
           return 0;
         },
         "evfs test", h5);
     const std::string errors = ::testing::internal::GetCapturedStderr();
-    EXPECT_EQ(status, 2) << errors;
+    if (status == kRefused) continue;
+    ++crashed;
     EXPECT_EQ(errors, "evfs test: " + h5 +
                           ": crashed (Segmentation fault) reading it; libhdf5 does so on some "
                           "corrupt HDF5 files\n");
   }
+  EXPECT_GE(crashed, 1) << "libhdf5 read both files: the crash attribution was not exercised";
 }
 
 void UseInternalErrorReporting() {

@@ -8,6 +8,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
@@ -190,6 +192,105 @@ TEST(ImageIoTest, SharedFramesAreEightBitOfTheSensorSize) {
   EXPECT_EQ(image.cols(), 240);
   EXPECT_EQ(image.rows(), 180);
   EXPECT_EQ(MinimalBitDepth(image), 8);
+}
+
+// OpenCV's imread(path, IMREAD_ANYDEPTH) scaled to [0, 1]: what evfs read frames with before
+// it decoded PNG files itself (io/png_codec.h), and what it must still read.
+Image ReadWithOpenCv(const std::string& path) {
+  const cv::Mat mat = cv::imread(path, cv::IMREAD_ANYDEPTH);
+  EXPECT_FALSE(mat.empty()) << path;
+  const double max_value = mat.depth() == CV_16U ? 65535.0 : 255.0;
+  Image image(mat.rows, mat.cols);
+  for (int y = 0; y < mat.rows; ++y) {
+    for (int x = 0; x < mat.cols; ++x) {
+      image(y, x) =
+          (mat.depth() == CV_16U ? mat.at<uint16_t>(y, x) : mat.at<uint8_t>(y, x)) / max_value;
+    }
+  }
+  return image;
+}
+
+// Every PNG layout OpenCV writes, and a JPEG (through the decoder plug-in), read as OpenCV
+// reads it: colour to the same grey, alpha dropped, 16 bits kept, 1-bit expanded.
+TEST(ImageIoTest, FramesDecodeAsOpenCvDecodesThem) {
+  const std::string dir = test::ScratchDir("image_like_opencv");
+  cv::RNG random(7);
+  struct Case {
+    const char* name;
+    int type;
+    std::vector<int> params;
+  };
+  const Case cases[] = {
+      {"grey8.png", CV_8UC1, {}},
+      {"grey16.png", CV_16UC1, {}},
+      {"bgr8.png", CV_8UC3, {}},
+      {"bgr16.png", CV_16UC3, {}},
+      {"bgra8.png", CV_8UC4, {}},
+      {"bgra16.png", CV_16UC4, {}},
+      {"bilevel.png", CV_8UC1, {cv::IMWRITE_PNG_BILEVEL, 1}},
+      {"level9.png", CV_8UC3, {cv::IMWRITE_PNG_COMPRESSION, 9}},
+      {"frame.jpg", CV_8UC3, {}},
+      {"frame.bmp", CV_8UC1, {}},
+  };
+  for (const Case& c : cases) {
+    cv::Mat mat(kHeight, kWidth, c.type);
+    random.fill(mat, cv::RNG::UNIFORM, 0, CV_MAT_DEPTH(c.type) == CV_16U ? 65536 : 256);
+    if (std::string(c.name) == "bilevel.png") mat = mat > 127;
+    const std::string path = dir + "/" + c.name;
+    ASSERT_TRUE(cv::imwrite(path, mat, c.params)) << c.name;
+    const Image expected = ReadWithOpenCv(path);
+    const Image read = ReadGreyImage(path);
+    ASSERT_EQ(read.rows(), expected.rows()) << c.name;
+    ASSERT_EQ(read.cols(), expected.cols()) << c.name;
+    EXPECT_TRUE((read == expected).all()) << c.name;
+  }
+}
+
+// What evfs writes, OpenCV reads back to the same values.
+TEST(ImageIoTest, WrittenFramesReadTheSameThroughOpenCv) {
+  const std::string dir = test::ScratchDir("image_written_opencv");
+  const Image image8 = test::MakeRandomImage(3, kWidth, kHeight, 8);
+  const Image image16 = test::MakeRandomImage(4, kWidth, kHeight, 16);
+  WriteGreyPng8(dir + "/a.png", image8);
+  WriteGreyPng16(dir + "/b.png", image16);
+  EXPECT_TRUE((ReadWithOpenCv(dir + "/a.png") == image8).all());
+  EXPECT_TRUE((ReadWithOpenCv(dir + "/b.png") == image16).all());
+}
+
+// A PNG cut short or with a broken chunk is one InputError naming the file, not a crash.
+TEST(ImageIoTest, ACorruptPngIsAnInputError) {
+  const std::string dir = test::ScratchDir("image_corrupt");
+  WriteGreyPng16(dir + "/whole.png", test::MakeRandomImage(5, kWidth, kHeight, 16));
+  const std::string whole = test::ReadFile(dir + "/whole.png");
+  std::string flipped = whole;
+  flipped[whole.size() / 2] = static_cast<char>(flipped[whole.size() / 2] ^ 0x55);
+  for (const auto& [name, bytes] :
+       {std::pair<std::string, std::string>{"cut.png", whole.substr(0, whole.size() / 2)},
+        {"flipped.png", flipped}}) {
+    test::WriteFile(dir + "/" + name, bytes);
+    test::ExpectInputError([&] { ReadGreyImage(dir + "/" + name); }, InputError::Kind::kMissingFile,
+                           dir + "/" + name, 0);
+  }
+}
+
+// The shared recordings' frames read as OpenCV reads them.
+TEST(ImageIoTest, SharedFramesDecodeAsOpenCvDecodesThem) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  int compared = 0;
+  for (const auto& folder : std::filesystem::directory_iterator(data_dir)) {
+    int in_folder = 0;
+    for (const char* images : {"images", "frames"}) {
+      std::error_code error;
+      for (const auto& entry : std::filesystem::directory_iterator(folder.path() / images, error)) {
+        if (entry.path().extension() != ".png" || in_folder >= 3) continue;
+        const std::string path = entry.path().string();
+        EXPECT_TRUE((ReadGreyImage(path) == ReadWithOpenCv(path)).all()) << path;
+        ++in_folder;
+      }
+    }
+    compared += in_folder;
+  }
+  EXPECT_GT(compared, 10);
 }
 
 }  // namespace
