@@ -37,8 +37,8 @@ ProgramHelp MakeEvfsHelp() {
       {"convert", "--data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR",
        "Convert a recording between a data folder, HDF5 and AEDAT 4 (or from AEDAT 2.0/3.1)."},
       {"calibrate", "--data=DIR [--first=I --last=J] --out=MODEL.json",
-       "Measure the event model of a recording from its own frames and events: b of log(I + b), "
-       "the ON and OFF thresholds, their spread and the background event rate, each with its "
+       "Measure the event model of a recording from its own frames and events (the offset b, "
+       "the ON and OFF thresholds, their spread, the background event rate), each with its "
        "standard error, into MODEL.json for --event_model=MODEL.json."},
       {"demo", "--out=DIR",
        "Run a synthetic scene through the whole pipeline and score every mode against its "
