@@ -262,7 +262,7 @@ EventModelCalibration CalibrateEventModel(const std::vector<Image>& frames,
         "cannot calibrate the event model: there are no events between the frames");
   }
 
-  // Each pixel's runs of usable frames (neither dark nor saturated) that change.
+  // Each pixel's runs of usable frames (neither dark nor saturated) that change and fire.
   std::vector<PixelRun> runs;
   int with_events = 0, with_on = 0, with_off = 0;
   const int num_frames = static_cast<int>(frames.size());
@@ -293,7 +293,13 @@ EventModelCalibration CalibrateEventModel(const std::vector<Image>& frames,
         lowest = std::min(lowest, intensity);
         highest = std::max(highest, intensity);
       }
-      if (run.intensities.size() < 2 || highest - lowest < options.min_frame_change) continue;
+      // A run without events says only that its level stayed inside the band, a bound that
+      // the residual, divided by the threshold, would turn into a pull towards larger
+      // thresholds; such runs are most of a real scene, so they enter the background rate only.
+      if (run.intensities.size() < 2 || highest - lowest < options.min_frame_change ||
+          on + off == 0.0) {
+        continue;
+      }
       with_events += on + off > 0.0 ? 1 : 0;
       with_on += on > 0.0 ? 1 : 0;
       with_off += off > 0.0 ? 1 : 0;

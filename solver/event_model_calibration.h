@@ -8,7 +8,11 @@
 // events from the first frame to frame k,
 //   log(I_k + b) - C_on · N_on,k + C_off · N_off,k
 // is the same at every frame up to that band (cost_functions/event_count_residual.h). A robust
-// (Huber) least-squares fit of its spread over every usable pixel gives b and the thresholds.
+// (Huber) least-squares fit of its spread over every usable pixel that fires gives b and the
+// thresholds. Pixels that change without firing are left out of it: they bound the thresholds
+// from below only, and as residuals in events (divided by the threshold) they would pull the
+// thresholds up; where most pixels fire rarely (real recordings, slow scenes) that pull tripled
+// the thresholds of a simulated sensor.
 // Taking the levels over several frames rather than the change between two keeps the band's
 // width from biasing the thresholds where the light reverses: a pixel that darkened before
 // needs more than C_on of rise for its first ON event, which a per-pair fit reads as a larger
@@ -33,8 +37,8 @@ struct EventModelCalibrationOptions {
   double saturation_level = 0.99;
   /// A pixel whose frames span less than this is left out of the fit, >= 0: with no change to
   /// explain it says nothing of b or the thresholds (only of the background, which is measured
-  /// apart), and static pixels are most of a scene. Choosing pixels by their frames, not by
-  /// their events, keeps the fit unbiased. 1/255: the step of 8-bit frames.
+  /// apart). 1/255: the step of 8-bit frames. Runs of frames without events are left out as
+  /// well (CalibrateEventModel).
   double min_frame_change = 1.0 / 255.0;
   /// Huber scale of the residual, in events, > 0: the band alone scatters a pixel's level by
   /// about ±0.5 events; a pixel that occlusion, noise or a hot pixel puts several events off

@@ -9,6 +9,8 @@
 #include "core/error.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
+#include "io/data_source.h"
+#include "tests/test_data.h"
 
 namespace evfs {
 namespace {
@@ -114,6 +116,42 @@ INSTANTIATE_TEST_SUITE_P(OffsetsAndThresholds, CalibrationRecovery,
                          ::testing::Values(Case{0.001, 0.15, 0.25}, Case{0.001, 0.2, 0.2},
                                            Case{0.001, 0.3, 0.3}, Case{0.1, 0.15, 0.25},
                                            Case{0.1, 0.2, 0.2}, Case{0.1, 0.3, 0.3}));
+
+// Real frames at 240 fps (the shared nfs_basketball_7 clip, 200x200): between frames most
+// pixels change by less than a threshold and fire rarely or never. Fitted too, such pixels
+// tripled the thresholds and ran b to its lower bound (a regression test).
+TEST(CalibrateEventModel, PixelsThatRarelyFireDoNotInflateTheThresholds) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  const auto source = DataSource::Open(data_dir + "/nfs_basketball_7");
+  ASSERT_GE(source->frames().size(), 15u);
+  Video video(source->height(), source->width(), 15);
+  for (int k = 0; k < 15; ++k) {
+    video.frame(k) = source->ReadImage(k);
+    video.set_timestamp_ns(k, source->frames()[k].t_ns);
+  }
+  SimulatorOptions sensor;
+  sensor.log_eps = 0.1;
+  sensor.contrast_threshold_pos = 0.2;
+  sensor.contrast_threshold_neg = 0.3;
+  const EventStream events = SimulateEvents(video, sensor);
+  std::vector<Image> frames;
+  std::vector<int64_t> times_ns;
+  for (int k = 10; k < 15; ++k) {
+    frames.push_back(video.frame(k));
+    times_ns.push_back(video.timestamp_ns(k));
+  }
+  const EventModelCalibration result =
+      CalibrateEventModel(frames, times_ns, events, EventModelCalibrationOptions());
+  SCOPED_TRACE(result.description);
+  // Few events per pixel and 8-bit frames: the OFF threshold comes out about 11 % low, b about
+  // 15 % high; the bounds leave a margin over those.
+  constexpr double kOnTolerance = 0.10;
+  constexpr double kOffTolerance = 0.15;
+  constexpr double kOffsetTolerance = 0.30;
+  EXPECT_NEAR(result.threshold_on.value, 0.2, kOnTolerance * 0.2);
+  EXPECT_NEAR(result.threshold_off.value, 0.3, kOffTolerance * 0.3);
+  EXPECT_NEAR(result.log_offset.value, 0.1, kOffsetTolerance * 0.1);
+}
 
 TEST(CalibrateEventModel, MeasuresTheThresholdSpread) {
   SimulatorOptions sensor;
