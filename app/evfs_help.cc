@@ -36,6 +36,10 @@ ProgramHelp MakeEvfsHelp() {
        "frames' exposure, saturation and noise (all off by default)."},
       {"convert", "--data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR",
        "Convert a recording between a data folder, HDF5 and AEDAT 4 (or from AEDAT 2.0/3.1)."},
+      {"calibrate", "--data=DIR [--first=I --last=J] --out=MODEL.json",
+       "Measure the event model of a recording from its own frames and events (the offset b, "
+       "the ON and OFF thresholds, their spread, the background event rate), each with its "
+       "standard error, into MODEL.json for --event_model=MODEL.json."},
       {"demo", "--out=DIR",
        "Run a synthetic scene through the whole pipeline and score every mode against its "
        "ground truth."},
@@ -52,17 +56,17 @@ ProgramHelp MakeEvfsHelp() {
                  "solver", "denoiser", "simulator", "progress"};
   help.flags = {
       // Which data and which frames.
-      {"data", "data", "info reconstruct convert video"},
+      {"data", "data", "info reconstruct convert video calibrate"},
       {"frames", "data", "simulate"},
       {"mode", "data", "reconstruct"},
-      {"first", "data", "info reconstruct video"},
-      {"last", "data", "info reconstruct video"},
+      {"first", "data", "info reconstruct video calibrate"},
+      {"last", "data", "info reconstruct video calibrate"},
       {"truth", "data", "reconstruct"},
       {"exposure_s", "data", "reconstruct video simulate"},
       {"frame_time", "data", "reconstruct"},
       // What is written.
-      {"out", "output", "reconstruct denoise simulate convert demo video"},
-      {"overwrite", "output", "reconstruct denoise simulate convert demo video"},
+      {"out", "output", "reconstruct denoise simulate convert demo video calibrate"},
+      {"overwrite", "output", "reconstruct denoise simulate convert demo video calibrate"},
       {"fps", "output", "reconstruct video"},
       // The method and its own settings.
       {"solver", "method", "reconstruct video"},
@@ -79,7 +83,7 @@ ProgramHelp MakeEvfsHelp() {
       {"min_latent_steps", "binning", "info reconstruct video"},
       {"max_latent_voxels", "binning", "info reconstruct video"},
       {"hot_pixel_factor", "binning", "info reconstruct video"},
-      {"saturation_level", "binning", "info reconstruct video"},
+      {"saturation_level", "binning", "info reconstruct video calibrate"},
       {"leave_out_saturated", "binning", "info reconstruct video"},
       {"flicker_min_reversals", "binning", "info reconstruct video"},
       {"noise_filter_ms", "binning", "info reconstruct video"},
@@ -133,11 +137,12 @@ ProgramHelp MakeEvfsHelp() {
       {"blur_from_data", "data", "video"},
       {"frame_step", "data", "video"},
       {"skip_bad_frames", "data", "video"},
-      {"allow_outside_paths", "data", "info reconstruct convert video simulate"},
+      {"allow_outside_paths", "data", "info reconstruct convert video simulate calibrate"},
       // The event simulator.
       {"threshold_pos", "simulator", "simulate"},
       {"threshold_neg", "simulator", "simulate"},
       {"threshold_sigma", "simulator", "simulate"},
+      {"log_eps", "simulator", "simulate"},
       {"refractory_s", "simulator", "simulate"},
       {"noise_rate_hz", "simulator", "simulate"},
       {"seed", "simulator", "simulate"},

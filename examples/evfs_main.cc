@@ -9,6 +9,7 @@
 //   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
 //                    [sensor effects, light sources and frame effects]
 //   evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR
+//   evfs calibrate   --data=DIR [--first=I --last=J] --out=MODEL.json
 //   evfs demo        --out=DIR
 //
 // Flags are read here and nowhere else; every failure that is the user's (a bad file, a bad
@@ -23,6 +24,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <new>
 #include <sstream>
@@ -31,6 +33,7 @@
 #include <vector>
 
 #include "app/allocator_tuning.h"
+#include "app/calibrate_job.h"
 #include "app/crash_guard.h"
 #include "app/demo.h"
 #include "app/denoise_job.h"
@@ -165,7 +168,10 @@ DEFINE_bool(per_polarity_alpha, evfs::EventModelEstimationOptions().per_polarity
             "apart for ON and OFF events (DAVIS thresholds differ) and give darkening steps "
             "their own alpha.");
 DEFINE_string(event_model, evfs::EventModelName(evfs::ObjectiveOptions().event_model.model),
-              "log (g(x) = log(x + b), paper Eq. 1) | linear (g(x) = x, paper Eq. 2).");
+              "log (g(x) = log(x + b), paper Eq. 1) | linear (g(x) = x, paper Eq. 2) | "
+              "FILE.json (written by evfs calibrate: the log model with the measured b, alpha "
+              "from the ON threshold and the OFF/ON ratio; --log_offset, --alpha and "
+              "--event_saturation given as well win).");
 DEFINE_double(log_offset, evfs::ObjectiveOptions().event_model.log_offset,
               "b of the log event model.");
 DEFINE_string(spatial_tv, "anisotropic",
@@ -300,6 +306,8 @@ DEFINE_double(threshold_neg, evfs::SimulatorOptions().contrast_threshold_neg,
               "simulate: OFF contrast threshold (log intensity).");
 DEFINE_double(threshold_sigma, evfs::SimulatorOptions().threshold_sigma,
               "simulate: per-pixel spread (std dev) of the thresholds.");
+DEFINE_double(log_eps, evfs::SimulatorOptions().log_eps,
+              "simulate: offset b of the sensor's log intensity log(I + b), > 0.");
 DEFINE_double(refractory_s, 0.0, "simulate: refractory period in seconds.");
 DEFINE_double(noise_rate_hz, evfs::SimulatorOptions().noise_rate_hz,
               "simulate: background noise events per pixel per second.");
@@ -431,6 +439,7 @@ int RunSimulate() {
   options.contrast_threshold_pos = FLAGS_threshold_pos;
   options.contrast_threshold_neg = FLAGS_threshold_neg;
   options.threshold_sigma = FLAGS_threshold_sigma;
+  options.log_eps = FLAGS_log_eps;
   options.refractory_period_ns = SecondsToNanoseconds(FLAGS_refractory_s);
   options.noise_rate_hz = FLAGS_noise_rate_hz;
   options.seed = FLAGS_seed;
@@ -489,6 +498,39 @@ int RunSimulate() {
   return 0;
 }
 
+// Whether flag `name` was left at its default (not given on the command line).
+bool FlagIsDefault(const char* name) {
+  gflags::CommandLineFlagInfo info;
+  gflags::GetCommandLineFlagInfo(name, &info);
+  return info.is_default;
+}
+
+int RunCalibrate() {
+  Require(!FLAGS_data.empty(), "calibrate needs --data=DIR or --data=FILE.h5");
+  Require(!FLAGS_out.empty(), "calibrate needs --out=MODEL.json");
+  Require(IsEventModelFile(FLAGS_out), "calibrate: --out must name a .json file");
+  Require(FLAGS_first >= -1 && FLAGS_last >= -1,
+          "--first, --last: a frame number must be 0 or more");
+  CalibrateRequest request;
+  request.data_path = FLAGS_data;
+  request.first = FLAGS_first;
+  request.last = FLAGS_last;
+  request.options.saturation_level = FLAGS_saturation_level;
+  OutputOptions options = OutputFromFlags("calibrate", FLAGS_data);
+  options.kind = OutputOptions::Kind::kFile;
+  options.is_own_file = [](const std::string& path) {
+    std::ifstream file(path);
+    std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    return text.find("\"evfs_calibration\"") != std::string::npos;
+  };
+  OutputTarget out(options);
+  const CalibrateResult result = RunCalibration(request);
+  WriteCalibration(request, result, out.staging());
+  out.Commit();
+  PrintCalibration(request, result, out.path(), stdout);
+  return 0;
+}
+
 // The request of the reconstruct flags; `with_mode` false for `video`, which has no --mode.
 ReconstructRequest RequestFromFlags(bool with_mode = true) {
   ReconstructRequest request;
@@ -530,7 +572,21 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   objective.event_model.saturation = FLAGS_event_saturation;
   options.estimation.per_polarity = FLAGS_per_polarity_alpha;
   objective.smoothing_scale = FLAGS_smoothing_scale;
-  objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
+  if (IsEventModelFile(FLAGS_event_model)) {
+    // The calibrated model; a model flag given on the command line as well wins.
+    const EventModelParams calibrated = ReadEventModelFile(FLAGS_event_model, options.estimation);
+    objective.event_model.model = calibrated.model;
+    if (FlagIsDefault("log_offset")) objective.event_model.log_offset = calibrated.log_offset;
+    if (FlagIsDefault("alpha")) {
+      objective.event_model.alpha = calibrated.alpha;
+      objective.event_model.off_alpha_ratio = calibrated.off_alpha_ratio;
+    }
+    if (FlagIsDefault("event_saturation")) {
+      objective.event_model.saturation = calibrated.saturation;
+    }
+  } else {
+    objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
+  }
   objective.spatial_tv = ParseName(kSpatialTvNames, FLAGS_spatial_tv, "--spatial_tv");
   objective.shared_structure_tv = FLAGS_shared_structure_tv;
   options.bound_intensities = FLAGS_bounds;
@@ -748,6 +804,7 @@ int RunCommand(const std::string& command) {
   if (command == "video") return RunVideoCommand(&progress);
   if (command == "simulate") return RunSimulate();
   if (command == "convert") return RunConvert();
+  if (command == "calibrate") return RunCalibrate();
   if (command == "denoise") return RunDenoise();
   if (command == "demo") {
     Require(!FLAGS_out.empty(), "demo needs --out=DIR");
@@ -759,7 +816,7 @@ int RunCommand(const std::string& command) {
   }
   throw InvalidArgumentError(
       "unknown command '" + command +
-      "': expected info, reconstruct, video, denoise, simulate, convert or demo "
+      "': expected info, reconstruct, video, denoise, simulate, convert, calibrate or demo "
       "(evfs --help)");
 }
 

@@ -152,6 +152,8 @@ ObjectiveOptions ResolveObjective(const Scene& scene, const ReconstructionOption
   } else {
     *model = EventModelEstimate();
     model->alpha = event_model.alpha;
+    // A given α comes with its OFF ratio (a calibrated model, --event_model=FILE.json).
+    model->off_alpha_ratio = event_model.off_alpha_ratio;
     // The change an event stands for when α was derived from it (EstimateEventModel).
     model->change_per_event = options.estimation.alpha_times_change / event_model.alpha;
     model->description = "alpha " + std::to_string(event_model.alpha) + " (given)";

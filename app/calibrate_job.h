@@ -1,0 +1,63 @@
+// `evfs calibrate`: the event model of a recording measured from its own frames and events
+// (solver/event_model_calibration.h), written as a JSON file that `--event_model=FILE.json`
+// reads back into the reconstruction's event model (docs/model.md, "Calibrating the event
+// model").
+#ifndef EVFS_APP_CALIBRATE_JOB_H_
+#define EVFS_APP_CALIBRATE_JOB_H_
+
+#include <cstdio>
+#include <string>
+
+#include "scene/event_model.h"
+#include "scene/event_model_estimation.h"
+#include "scene/frame_timing.h"
+#include "solver/event_model_calibration.h"
+
+namespace evfs {
+
+struct CalibrateRequest {
+  std::string data_path;
+  int first = -1;  // first frame (images.txt line); -1: the first
+  int last = -1;   // last frame; -1: the last
+  EventModelCalibrationOptions options;
+};
+
+struct CalibrateResult {
+  EventModelCalibration calibration;
+  /// The frame lag (scene/frame_timing.h), estimated with the calibrated b: reported, not
+  /// part of the fit.
+  FrameLagEstimate frame_lag;
+  int first = 0;
+  int last = 0;
+  double time_s = 0.0;  // reading and fitting, seconds
+};
+
+/// Reads frames first..last and their events and calibrates. Throws InputError (or
+/// InvalidArgumentError) with one line when the recording cannot tell: fewer than two frames,
+/// no events, frames outside the recording, nothing that changes.
+CalibrateResult RunCalibration(const CalibrateRequest& request);
+
+/// Prints what was found: each value with its standard error and counts, the frame lag, and
+/// the event model it gives.
+void PrintCalibration(const CalibrateRequest& request, const CalibrateResult& result,
+                      const std::string& out_path, std::FILE* out);
+
+/// Writes `result` as the JSON file `path`.
+void WriteCalibration(const CalibrateRequest& request, const CalibrateResult& result,
+                      const std::string& path);
+
+/// True when a --event_model value names a calibration file (it ends in .json) rather than a
+/// model (log, linear).
+bool IsEventModelFile(const std::string& value);
+
+/// The event model a calibration file gives: the log model with its b; α so that one ON event
+/// stands for C_on (α = estimation.alpha_times_change / C_on, as EstimateEventModel derives it
+/// from a measured change); darkening steps α · C_on / C_off (off_alpha_ratio); and c =
+/// estimation.measured_saturation, as for a change measured between frames. Throws InputError
+/// for a missing or malformed file.
+EventModelParams ReadEventModelFile(const std::string& path,
+                                    const EventModelEstimationOptions& estimation);
+
+}  // namespace evfs
+
+#endif  // EVFS_APP_CALIBRATE_JOB_H_
