@@ -111,7 +111,8 @@ std::string FlagSections(const ProgramHelp& help, const std::string& command) {
   for (const FlagHelp& row : help.flags) with_row.insert(row.flag);
   std::string others;
   for (const auto& [name, info] : flags) {
-    if (EndsWith(info.filename, help.flags_file) && !with_row.count(name)) {
+    if (!help.flags_file.empty() && EndsWith(info.filename, help.flags_file) &&
+        !with_row.count(name)) {
       others += FlagEntry(info, "");
     }
   }
@@ -207,7 +208,8 @@ std::vector<std::string> CheckHelpTables(const ProgramHelp& help) {
     }
   }
   for (const auto& [name, info] : flags) {
-    if (EndsWith(info.filename, help.flags_file) && !with_row.count(name)) {
+    if (!help.flags_file.empty() && EndsWith(info.filename, help.flags_file) &&
+        !with_row.count(name)) {
       problems.push_back("--" + name + " (" + info.filename + "): no row in the help table");
     }
   }

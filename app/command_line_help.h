@@ -42,8 +42,8 @@ struct ProgramHelp {
   std::vector<FlagHelp> flags;
   /// Shown after the commands of the overview (what the arguments mean, an example).
   std::string notes;
-  /// Where the program's own flags are defined (the end of gflags' file name, e.g.
-  /// "evfs_main.cc"): those without a row are shown under "other" rather than left out.
+  /// Where the program's own flags are defined (the end of gflags' file name: the __FILE__ of
+  /// the DEFINE_ lines): those without a row are shown under "other" rather than left out.
   std::string flags_file;
 };
 

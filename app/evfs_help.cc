@@ -10,7 +10,6 @@ ProgramHelp MakeEvfsHelp() {
   help.program = "evfs";
   help.summary = "event-driven video frame synthesis.";
   help.version = kVersion;
-  help.flags_file = "evfs_main.cc";
   help.commands = {
       {"info", "--data=DIR [--first=I --last=J]",
        "Describe a recording: size, events, frames and exposures; with --first, the window "

@@ -669,7 +669,7 @@ std::string VideoSettings() {
   std::vector<gflags::CommandLineFlagInfo> flags;
   gflags::GetAllFlags(&flags);
   for (const gflags::CommandLineFlagInfo& flag : flags) {
-    if (flag.filename.find("evfs_main.cc") == std::string::npos) continue;
+    if (flag.filename != __FILE__) continue;  // not one of evfs' own (MainHelp)
     if (std::find(std::begin(kNotSettings), std::end(kNotSettings), flag.name) !=
         std::end(kNotSettings)) {
       continue;
@@ -886,6 +886,17 @@ std::string FlagValue(const char* name) {
   return value;
 }
 
+// evfs' help (app/evfs_help.h), its own flags being those defined in this file: gflags records
+// the __FILE__ of each DEFINE_, so that renaming the file changes nothing.
+const ProgramHelp& MainHelp() {
+  static const ProgramHelp help = [] {
+    ProgramHelp main_help = EvfsHelp();
+    main_help.flags_file = __FILE__;
+    return main_help;
+  }();
+  return help;
+}
+
 // gflags' help flags print and then exit with status 1; help asked for is a success. --help
 // and --helpshort show evfs' own flags by group (app/evfs_help.h), only the command's when one
 // is given; --helpfull shows every flag, glog's and gflags' too, as gflags does. Returns true
@@ -893,7 +904,7 @@ std::string FlagValue(const char* name) {
 bool ShowHelpAskedFor(int argc, char** argv) {
   if (FlagValue("help") == "true" || FlagValue("helpshort") == "true") {
     const std::string text =
-        argc >= 2 ? CommandHelpText(EvfsHelp(), argv[1]) : ProgramHelpText(EvfsHelp());
+        argc >= 2 ? CommandHelpText(MainHelp(), argv[1]) : ProgramHelpText(MainHelp());
     std::fputs(text.c_str(), stdout);
   } else if (FlagValue("helpfull") == "true" || FlagValue("helppackage") == "true") {
     gflags::ShowUsageWithFlags(argv[0]);
