@@ -392,6 +392,12 @@ int RunInfo() {
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
     PrintWindow(*source, FLAGS_first, last, BinningFromFlags(), FLAGS_binning, stdout);
   }
+  if (FLAGS_first >= 0) {
+    PrintInfoCalibration(*source, FLAGS_data, FLAGS_first,
+                         FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1, stdout);
+  } else {
+    PrintInfoCalibration(*source, FLAGS_data, 0, FLAGS_last, stdout);
+  }
   return 0;
 }
 
@@ -675,6 +681,10 @@ std::string VideoSettings() {
       continue;
     }
     settings += flag.name + "=" + flag.current_value + " ";
+  }
+  // A calibration file edited in place keeps its path: its bytes decide the model.
+  if (IsEventModelFile(FLAGS_event_model)) {
+    settings += "event_model_file_bytes=" + EventModelFileFingerprint(FLAGS_event_model) + " ";
   }
   return settings;
 }
