@@ -217,4 +217,17 @@ EventModelParams ReadEventModelFile(const std::string& path,
   return params;
 }
 
+void ApplyEventModelFile(const std::string& path, const EventModelEstimationOptions& estimation,
+                         bool keep_log_offset, bool keep_alpha, bool keep_saturation,
+                         EventModelParams* model) {
+  const EventModelParams calibrated = ReadEventModelFile(path, estimation);
+  model->model = calibrated.model;
+  if (!keep_log_offset) model->log_offset = calibrated.log_offset;
+  if (!keep_alpha) {
+    model->alpha = calibrated.alpha;
+    model->off_alpha_ratio = calibrated.off_alpha_ratio;
+  }
+  if (!keep_saturation) model->saturation = calibrated.saturation;
+}
+
 }  // namespace evfs

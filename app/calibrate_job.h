@@ -81,6 +81,13 @@ bool IsEventModelFile(const std::string& value);
 EventModelParams ReadEventModelFile(const std::string& path,
                                     const EventModelEstimationOptions& estimation);
 
+/// Sets `model` from the calibration file `path` (ReadEventModelFile), as --event_model=FILE.json
+/// does: the log model always; b, α with its OFF ratio, and the saturation each unless the
+/// caller was given it explicitly (`keep_log_offset`, `keep_alpha`, `keep_saturation`).
+void ApplyEventModelFile(const std::string& path, const EventModelEstimationOptions& estimation,
+                         bool keep_log_offset, bool keep_alpha, bool keep_saturation,
+                         EventModelParams* model);
+
 }  // namespace evfs
 
 #endif  // EVFS_APP_CALIBRATE_JOB_H_

@@ -580,16 +580,9 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   objective.smoothing_scale = FLAGS_smoothing_scale;
   if (IsEventModelFile(FLAGS_event_model)) {
     // The calibrated model; a model flag given on the command line as well wins.
-    const EventModelParams calibrated = ReadEventModelFile(FLAGS_event_model, options.estimation);
-    objective.event_model.model = calibrated.model;
-    if (FlagIsDefault("log_offset")) objective.event_model.log_offset = calibrated.log_offset;
-    if (FlagIsDefault("alpha")) {
-      objective.event_model.alpha = calibrated.alpha;
-      objective.event_model.off_alpha_ratio = calibrated.off_alpha_ratio;
-    }
-    if (FlagIsDefault("event_saturation")) {
-      objective.event_model.saturation = calibrated.saturation;
-    }
+    ApplyEventModelFile(FLAGS_event_model, options.estimation, !FlagIsDefault("log_offset"),
+                        !FlagIsDefault("alpha"), !FlagIsDefault("event_saturation"),
+                        &objective.event_model);
   } else {
     objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
   }
