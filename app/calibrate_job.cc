@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -37,13 +38,20 @@ Json ValueJson(const CalibratedValue& value) {
 CalibrateResult RunCalibration(const CalibrateRequest& request) {
   const auto start = std::chrono::steady_clock::now();
   const auto source = DataSource::Open(request.data_path);
-  const int num_frames = static_cast<int>(source->frames().size());
+  CalibrateResult result = RunCalibration(*source, request);
+  result.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+CalibrateResult RunCalibration(const DataSource& source, const CalibrateRequest& request) {
+  const auto start = std::chrono::steady_clock::now();
+  const int num_frames = static_cast<int>(source.frames().size());
   if (num_frames < 2) {
     throw InputError(
         InputError::Kind::kEmptyWindow, request.data_path, 0,
         "calibration needs two frames or more, the recording has " + std::to_string(num_frames));
   }
-  if (!source->has_events()) {
+  if (!source.has_events()) {
     throw InputError(InputError::Kind::kEmptyWindow, request.data_path, 0,
                      "calibration needs events, the recording has none");
   }
@@ -59,15 +67,18 @@ CalibrateResult RunCalibration(const CalibrateRequest& request) {
         "calibration needs two frames or more: --last must be after --first (got " +
         std::to_string(result.first) + " and " + std::to_string(result.last) + ")");
   }
+  if (request.max_frames >= 2) {
+    result.last = std::min(result.last, result.first + request.max_frames - 1);
+  }
   std::vector<Image> frames;
   std::vector<int64_t> times_ns;
   std::vector<int> indices;
   for (int i = result.first; i <= result.last; ++i) {
-    frames.push_back(source->ReadImage(i));
-    times_ns.push_back(source->frames()[i].t_ns);
+    frames.push_back(source.ReadImage(i));
+    times_ns.push_back(source.frames()[i].t_ns);
     indices.push_back(i);
   }
-  const EventStream events = source->ReadEvents(
+  const EventStream events = source.ReadEvents(
       times_ns.front() - SecondsToNanoseconds(kEventsBeforeFirstFrameS), times_ns.back() + 1);
   try {
     result.calibration = CalibrateEventModel(frames, times_ns, events, request.options);
@@ -75,9 +86,11 @@ CalibrateResult RunCalibration(const CalibrateRequest& request) {
     // What the data cannot tell is the recording's, not a flag's: named with its path.
     throw InputError(InputError::Kind::kEmptyWindow, request.data_path, 0, error.what());
   }
-  FrameLagOptions lag;
-  lag.log_offset = result.calibration.log_offset.value;
-  result.frame_lag = EstimateRecordingFrameLag(*source, indices, lag);
+  if (request.estimate_frame_lag) {
+    FrameLagOptions lag;
+    lag.log_offset = result.calibration.log_offset.value;
+    result.frame_lag = EstimateRecordingFrameLag(source, indices, lag);
+  }
   result.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -126,6 +139,47 @@ void WriteCalibration(const CalibrateRequest& request, const CalibrateResult& re
   if (!file) throw InputError(InputError::Kind::kUnwritable, path, 0, "cannot write the file");
 }
 
+void PrintInfoCalibration(const DataSource& source, const std::string& data_path, int first,
+                          int last, std::FILE* out) {
+  CalibrateRequest request;
+  request.data_path = data_path;
+  request.first = first;
+  request.last = last;
+  request.max_frames = kInfoCalibrationFrames;
+  request.estimate_frame_lag = false;
+  CalibrateResult result;
+  try {
+    result = RunCalibration(source, request);
+  } catch (const std::exception& error) {
+    // InputError and InvalidArgumentError say what is missing in one line; the rest of info
+    // stands without this section.
+    std::fprintf(out, "event model: cannot tell: %s\n", error.what());
+    return;
+  }
+  const int selected_last = last >= 0 ? last : static_cast<int>(source.frames().size()) - 1;
+  std::fprintf(out, "event model (as evfs calibrate) on frames %d to %d", result.first,
+               result.last);
+  if (result.last < selected_last) {
+    std::fprintf(out, ", the first %d of the selection (evfs calibrate fits them all)",
+                 result.last - result.first + 1);
+  }
+  std::fprintf(out, ", %.2f s:\n", result.time_s);
+  std::fputs(result.calibration.description.c_str(), out);
+}
+
+std::string EventModelFileFingerprint(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return "unreadable";
+  // FNV-1a, 64 bits: notices an edited file, no defence against a made-up collision.
+  uint64_t hash = 14695981039346656037ull;
+  for (char byte; file.get(byte);) {
+    hash = (hash ^ static_cast<unsigned char>(byte)) * 1099511628211ull;
+  }
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
 bool IsEventModelFile(const std::string& value) {
   return value.size() > 5 && value.compare(value.size() - 5, 5, ".json") == 0;
 }
@@ -161,6 +215,19 @@ EventModelParams ReadEventModelFile(const std::string& path,
   params.off_alpha_ratio = on / off;
   params.saturation = estimation.measured_saturation;
   return params;
+}
+
+void ApplyEventModelFile(const std::string& path, const EventModelEstimationOptions& estimation,
+                         bool keep_log_offset, bool keep_alpha, bool keep_saturation,
+                         EventModelParams* model) {
+  const EventModelParams calibrated = ReadEventModelFile(path, estimation);
+  model->model = calibrated.model;
+  if (!keep_log_offset) model->log_offset = calibrated.log_offset;
+  if (!keep_alpha) {
+    model->alpha = calibrated.alpha;
+    model->off_alpha_ratio = calibrated.off_alpha_ratio;
+  }
+  if (!keep_saturation) model->saturation = calibrated.saturation;
 }
 
 }  // namespace evfs

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "io/data_source.h"
 #include "scene/event_model.h"
 #include "scene/event_model_estimation.h"
 #include "scene/frame_timing.h"
@@ -19,6 +20,10 @@ struct CalibrateRequest {
   std::string data_path;
   int first = -1;  // first frame (images.txt line); -1: the first
   int last = -1;   // last frame; -1: the last
+  /// At most this many frames from `first` are read and fitted, >= 2; 0: all of first..last.
+  int max_frames = 0;
+  /// Also estimate the frame lag with the calibrated b (a second pass over the frames).
+  bool estimate_frame_lag = true;
   EventModelCalibrationOptions options;
 };
 
@@ -28,7 +33,7 @@ struct CalibrateResult {
   /// part of the fit.
   FrameLagEstimate frame_lag;
   int first = 0;
-  int last = 0;
+  int last = 0;         // the last frame fitted (before request.last when max_frames cut it)
   double time_s = 0.0;  // reading and fitting, seconds
 };
 
@@ -36,6 +41,24 @@ struct CalibrateResult {
 /// InvalidArgumentError) with one line when the recording cannot tell: fewer than two frames,
 /// no events, frames outside the recording, nothing that changes.
 CalibrateResult RunCalibration(const CalibrateRequest& request);
+
+/// The same on a recording already open (request.data_path only names it in errors).
+CalibrateResult RunCalibration(const DataSource& source, const CalibrateRequest& request);
+
+/// `evfs info`'s section on the event model: b, C_on, C_off, their spread and the background
+/// rate, each with its standard error, calibrated on frames first..last but no more than the
+/// first kInfoCalibrationFrames of them (the section says which), without the frame lag; or
+/// one line saying why the recording cannot tell. `first`/`last` as in CalibrateRequest.
+void PrintInfoCalibration(const DataSource& source, const std::string& data_path, int first,
+                          int last, std::FILE* out);
+
+/// Frames `evfs info` calibrates on at most: few enough that the section costs about one
+/// small calibration (well under a second at 240x180) whatever the recording's length.
+constexpr int kInfoCalibrationFrames = 3;
+
+/// A fingerprint of a calibration file's bytes (FNV-1a, hexadecimal), for `video --resume` to
+/// notice a file changed in place; "unreadable" when it cannot be read.
+std::string EventModelFileFingerprint(const std::string& path);
 
 /// Prints what was found: each value with its standard error and counts, the frame lag, and
 /// the event model it gives.
@@ -57,6 +80,13 @@ bool IsEventModelFile(const std::string& value);
 /// for a missing or malformed file.
 EventModelParams ReadEventModelFile(const std::string& path,
                                     const EventModelEstimationOptions& estimation);
+
+/// Sets `model` from the calibration file `path` (ReadEventModelFile), as --event_model=FILE.json
+/// does: the log model always; b, α with its OFF ratio, and the saturation each unless the
+/// caller was given it explicitly (`keep_log_offset`, `keep_alpha`, `keep_saturation`).
+void ApplyEventModelFile(const std::string& path, const EventModelEstimationOptions& estimation,
+                         bool keep_log_offset, bool keep_alpha, bool keep_saturation,
+                         EventModelParams* model);
 
 }  // namespace evfs
 

@@ -13,7 +13,8 @@ ProgramHelp MakeEvfsHelp() {
   help.commands = {
       {"info", "--data=DIR [--first=I --last=J]",
        "Describe a recording: size, events, frames and exposures; with --first, the window "
-       "between two frames and the binning a reconstruction would get."},
+       "between two frames and the binning a reconstruction would get; and the event model "
+       "evfs calibrate finds on the first frames of the selection."},
       {"reconstruct",
        "--data=DIR --mode=interpolate|predict|deblur --first=I [--last=J] [--truth=K] --out=OUT "
        "[--fps=N] [method, binning, model and solver flags]",

@@ -392,6 +392,12 @@ int RunInfo() {
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
     PrintWindow(*source, FLAGS_first, last, BinningFromFlags(), FLAGS_binning, stdout);
   }
+  if (FLAGS_first >= 0) {
+    PrintInfoCalibration(*source, FLAGS_data, FLAGS_first,
+                         FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1, stdout);
+  } else {
+    PrintInfoCalibration(*source, FLAGS_data, 0, FLAGS_last, stdout);
+  }
   return 0;
 }
 
@@ -574,16 +580,9 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
   objective.smoothing_scale = FLAGS_smoothing_scale;
   if (IsEventModelFile(FLAGS_event_model)) {
     // The calibrated model; a model flag given on the command line as well wins.
-    const EventModelParams calibrated = ReadEventModelFile(FLAGS_event_model, options.estimation);
-    objective.event_model.model = calibrated.model;
-    if (FlagIsDefault("log_offset")) objective.event_model.log_offset = calibrated.log_offset;
-    if (FlagIsDefault("alpha")) {
-      objective.event_model.alpha = calibrated.alpha;
-      objective.event_model.off_alpha_ratio = calibrated.off_alpha_ratio;
-    }
-    if (FlagIsDefault("event_saturation")) {
-      objective.event_model.saturation = calibrated.saturation;
-    }
+    ApplyEventModelFile(FLAGS_event_model, options.estimation, !FlagIsDefault("log_offset"),
+                        !FlagIsDefault("alpha"), !FlagIsDefault("event_saturation"),
+                        &objective.event_model);
   } else {
     objective.event_model.model = ParseName(kEventModelNames, FLAGS_event_model, "--event_model");
   }
@@ -675,6 +674,10 @@ std::string VideoSettings() {
       continue;
     }
     settings += flag.name + "=" + flag.current_value + " ";
+  }
+  // A calibration file edited in place keeps its path: its bytes decide the model.
+  if (IsEventModelFile(FLAGS_event_model)) {
+    settings += "event_model_file_bytes=" + EventModelFileFingerprint(FLAGS_event_model) + " ";
   }
   return settings;
 }

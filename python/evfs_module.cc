@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/calibrate_job.h"
 #include "app/reconstruct_job.h"
 #include "app/video_job.h"
 #include "core/error.h"
@@ -489,6 +490,11 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
       " last=" + std::to_string(request.windows.last) + " fps=" + std::to_string(fps) +
       " frame_step=" + std::to_string(request.windows.frame_step) +
       " predict_tail=" + std::to_string(predict_tail) + " preview=" + std::to_string(preview);
+  // A calibration file rewritten in place keeps its path: its bytes decide the model.
+  if (!settings.event_model_file.empty()) {
+    request.settings +=
+        " event_model_file_bytes=" + EventModelFileFingerprint(settings.event_model_file);
+  }
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
   OutputOptions output;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/calibrate_job.h"
 #include "app/denoise_job.h"
 #include "app/initialization.h"
 #include "core/enum_names.h"
@@ -183,8 +184,25 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
                       [](R& s) -> double& { return Objective(s).event_model.saturation; }),
       BoolOption<R>("per_polarity_alpha",
                     [](R& s) -> bool& { return Rec(s).estimation.per_polarity; }),
-      EnumOption<R>("event_model", kEventModelNames,
-                    [](R& s) -> EventModel& { return Objective(s).event_model.model; }),
+      // A model name, or a calibration file read once every option is set
+      // (ApplyReconstructOptions).
+      {"event_model",
+       [](const R& s) {
+         return s.event_model_file.empty()
+                    ? py::cast(std::string(
+                          NameOf(kEventModelNames,
+                                 s.request.method.reconstruction.objective.event_model.model)))
+                    : py::cast(s.event_model_file);
+       },
+       [](py::handle v, R* s) {
+         const std::string value = ToString("event_model", v);
+         s->event_model_file.clear();
+         if (IsEventModelFile(value)) {
+           s->event_model_file = value;
+         } else {
+           Objective(*s).event_model.model = ParseName(kEventModelNames, value, "--event_model");
+         }
+       }},
       DoubleOption<R>("log_offset",
                       [](R& s) -> double& { return Objective(s).event_model.log_offset; }),
       EnumOption<R>("spatial_tv", kSpatialTvNames,
@@ -287,6 +305,7 @@ const std::vector<Option<S>>& SimulateOptionTable() {
       DoubleOption<S>("threshold_pos", [](S& s) -> double& { return s.contrast_threshold_pos; }),
       DoubleOption<S>("threshold_neg", [](S& s) -> double& { return s.contrast_threshold_neg; }),
       DoubleOption<S>("threshold_sigma", [](S& s) -> double& { return s.threshold_sigma; }),
+      DoubleOption<S>("log_eps", [](S& s) -> double& { return s.log_eps; }),
       {"refractory_s",
        [](const S& s) { return py::cast(NanosecondsToSeconds(s.refractory_period_ns)); },
        [](py::handle v, S* s) {
@@ -350,6 +369,15 @@ ReconstructSettings DefaultReconstructSettings() {
 
 void ApplyReconstructOptions(const py::handle& options, ReconstructSettings* settings) {
   Apply(ReconstructOptionTable(), options, settings);
+  if (settings->event_model_file.empty()) return;
+  // As --event_model=FILE.json: the options given beside it win over the file.
+  const auto given = [&options](const char* key) {
+    return py::reinterpret_borrow<py::dict>(options).contains(key);
+  };
+  ReconstructionOptions& reconstruction = settings->request.method.reconstruction;
+  ApplyEventModelFile(settings->event_model_file, reconstruction.estimation, given("log_offset"),
+                      given("alpha"), given("event_saturation"),
+                      &reconstruction.objective.event_model);
 }
 
 void ResolveDenoise(ReconstructSettings* settings) {

@@ -19,6 +19,9 @@ namespace evfs {
 struct ReconstructSettings {
   ReconstructRequest request;
   std::string denoise = "auto";  // auto | none | once
+  /// event_model given as a calibration file (FILE.json, written by `evfs calibrate`); "" for
+  /// a model name.
+  std::string event_model_file;
 };
 
 /// The command line's defaults (examples/evfs_main.cc's DEFINE_ lines).

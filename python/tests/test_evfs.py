@@ -6,6 +6,7 @@ Every comparison with the command line runs the command on the same input and co
 files with what the module returns.
 """
 import glob
+import json
 import os
 import re
 import signal
@@ -254,6 +255,47 @@ def test_reconstruct_shared_data_identical_to_cli(tmp_path):
     cli_frames, cli_times, result = reconstruct_both(data, tmp_path, "predict", 0, 1)
     np.testing.assert_array_equal(result["times"], cli_times)
     np.testing.assert_array_equal(quantize_like_png(result["frames"]), cli_frames)
+
+
+def test_reconstruct_reads_a_calibration_file_as_the_cli(demo, tmp_path):
+    """options={"event_model": "MODEL.json"} is --event_model=MODEL.json: the same frames, the
+    model the file gives (alpha = 1/C_on, OFF ratio C_on/C_off), options beside it winning."""
+    model = tmp_path / "model.json"
+    status, _, stderr = run_cli("calibrate", f"--data={demo / 'data'}", f"--out={model}")
+    assert status == 0, stderr
+    with open(model) as file:
+        calibration = json.load(file)
+    on = calibration["threshold_on"]["value"]
+    off = calibration["threshold_off"]["value"]
+    cli_frames, cli_times, result = reconstruct_both(
+        demo / "data", tmp_path, "interpolate", 1, 3, cli_flags=(f"--event_model={model}",),
+        options={"event_model": str(model)})
+    np.testing.assert_array_equal(result["times"], cli_times)
+    np.testing.assert_array_equal(quantize_like_png(result["frames"]), cli_frames)
+    summary = result["summary"]["model"]
+    assert summary["event_model"] == "log"
+    assert summary["alpha"] == pytest.approx(1.0 / on, rel=1e-9)
+    assert summary["off_alpha_ratio"] == pytest.approx(on / off, rel=1e-9)
+
+    # b given beside the file wins, as --log_offset does on the command line.
+    (tmp_path / "given").mkdir()
+    cli_frames, cli_times, given = reconstruct_both(
+        demo / "data", tmp_path / "given", "interpolate", 1, 3,
+        cli_flags=(f"--event_model={model}", "--log_offset=0.5"),
+        options={"event_model": str(model), "log_offset": 0.5})
+    np.testing.assert_array_equal(quantize_like_png(given["frames"]), cli_frames)
+    assert given["summary"]["model"]["alpha"] == pytest.approx(1.0 / on, rel=1e-9)
+    assert not np.array_equal(given["frames"], result["frames"])
+
+    recording = evfs.read(str(demo / "data"))
+
+    missing = str(tmp_path / "none.json")
+    with pytest.raises(ValueError, match="none.json"):
+        evfs.reconstruct(recording["frames"], recording["frame_times"], recording["events"],
+                         mode="interpolate", first=1, last=3, options={"event_model": missing})
+    with pytest.raises(ValueError, match="--event_model"):
+        evfs.reconstruct(recording["frames"], recording["frame_times"], recording["events"],
+                         mode="interpolate", first=1, last=3, options={"event_model": "cubic"})
 
 
 def test_reconstruct_float32_is_the_float64_result_rounded(demo):

@@ -3,6 +3,7 @@
 // own.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -114,6 +115,53 @@ TEST(EvfsCalibrate, AMissingOrMalformedModelFileIsAUserError) {
                           "--last=4 --out=" + out.string() +
                           " --event_model=" + (scratch / "bad.json").string()),
                   "bad.json", out);
+}
+
+// evfs info ends with the calibration: each value with its standard error, on no more than the
+// first few frames of the selection (and says so), or one line saying why it cannot tell.
+TEST(EvfsCalibrate, InfoPrintsTheEventModelOfTheFirstFrames) {
+  const fs::path scratch = test::ScratchDir("calibrate_info");
+  fs::remove_all(scratch);
+  const std::string data = WriteRecording(scratch);
+  const CommandResult whole = RunEvfs("info --data=" + data);
+  ASSERT_EQ(whole.exit_code, 0) << whole.output;
+  // 9 frames: calibrated on the first kInfoCalibrationFrames (3) of them only.
+  EXPECT_NE(whole.output.find("event model (as evfs calibrate) on frames 0 to 2, the first 3 of "
+                              "the selection"),
+            std::string::npos)
+      << whole.output;
+  for (const char* name : {"b (log offset)", "C_on", "threshold spread", "background rate"}) {
+    EXPECT_NE(whole.output.find(name), std::string::npos) << name << "\n" << whole.output;
+  }
+  // The same thresholds as `evfs calibrate` on those frames.
+  const fs::path model = scratch / "model.json";
+  ASSERT_EQ(
+      RunEvfs("calibrate --data=" + data + " --first=0 --last=2 --out=" + model.string()).exit_code,
+      0);
+  std::ifstream file(model);
+  const nlohmann::json json = nlohmann::json::parse(file);
+  char on_line[64];
+  std::snprintf(on_line, sizeof(on_line), "%-22s %.4g ± ",
+                json["thresholds_tied"].get<bool>() ? "C_on = C_off (tied)" : "C_on (ON threshold)",
+                json["threshold_on"]["value"].get<double>());
+  EXPECT_NE(whole.output.find(on_line), std::string::npos) << on_line << "\n" << whole.output;
+
+  // A window of two frames is calibrated whole, without the note.
+  const CommandResult window = RunEvfs("info --data=" + data + " --first=4 --last=5");
+  ASSERT_EQ(window.exit_code, 0) << window.output;
+  EXPECT_NE(window.output.find("on frames 4 to 5, "), std::string::npos) << window.output;
+  EXPECT_EQ(window.output.find("of the selection"), std::string::npos) << window.output;
+
+  // A recording without events: info still describes it, the section is one line.
+  const fs::path quiet = scratch / "quiet";
+  fs::create_directories(quiet);
+  fs::copy(data, quiet / "data", fs::copy_options::recursive);
+  std::ofstream(quiet / "data" / "events.txt", std::ios::trunc).close();
+  const CommandResult none = RunEvfs("info --data=" + (quiet / "data").string());
+  ASSERT_EQ(none.exit_code, 0) << none.output;
+  EXPECT_NE(none.output.find("event model: cannot tell: "), std::string::npos) << none.output;
+  EXPECT_NE(none.output.find("no events"), std::string::npos) << none.output;
+  EXPECT_EQ(none.output.find("C_on"), std::string::npos) << none.output;
 }
 
 }  // namespace

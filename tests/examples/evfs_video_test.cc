@@ -149,6 +149,25 @@ TEST(EvfsVideo, OneJobAndTwoJobsWriteTheSameFrames) {
   EXPECT_GT(fs::file_size(root / "two" / "preview.mp4"), 0u);
 }
 
+// Starts `evfs arguments` (whose --out is root/out) and stops it with SIGINT once it has
+// finished window `window_file` (e.g. "000002.json"), as a user interrupting a long run;
+// fails the test if the run ends before.
+void InterruptAfterWindow(const std::vector<std::string>& arguments, const fs::path& root,
+                          const std::string& window_file) {
+  const pid_t pid = StartEvfs(arguments, root);
+  ASSERT_GT(pid, 0);
+  const fs::path window = root / ".out.evfs-video-work" / "windows" / window_file;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(window) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(fs::exists(window)) << "no window finished: " << ReadFile(root / "stderr.txt");
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before the signal: make it longer";
+}
+
 TEST(EvfsVideo, AnInterruptedRunResumesIntoTheSameOutput) {
   const fs::path root = test::ScratchDir("video_resume");
   // 30 windows, solved one at a time: the run is stopped after its first windows.
@@ -165,18 +184,9 @@ TEST(EvfsVideo, AnInterruptedRunResumesIntoTheSameOutput) {
   const fs::path out = root / "out";
   std::vector<std::string> interrupted = arguments;
   interrupted.push_back("--out=" + out.string());
-  const pid_t pid = StartEvfs(interrupted, root);
-  ASSERT_GT(pid, 0);
+  InterruptAfterWindow(interrupted, root, "000002.json");
+  if (HasFatalFailure()) return;
   const fs::path work = root / ".out.evfs-video-work";
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (!fs::exists(work / "windows" / "000002.json") &&
-         std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  ASSERT_TRUE(fs::exists(work / "windows" / "000002.json")) << "no window finished";
-  ASSERT_EQ(kill(pid, SIGINT), 0);
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before the signal: make it longer";
   EXPECT_FALSE(fs::exists(out));
   EXPECT_TRUE(fs::exists(work / ".evfs-video-work"));
 
@@ -202,19 +212,9 @@ TEST(EvfsVideo, ResumeRecomputesTheWindowsWhoseRecordingChanged) {
   const fs::path out = root / "out";
   std::vector<std::string> interrupted = arguments;
   interrupted.push_back("--out=" + out.string());
-  const pid_t pid = StartEvfs(interrupted, root);
-  ASSERT_GT(pid, 0);
+  InterruptAfterWindow(interrupted, root, "000002.json");
+  if (HasFatalFailure()) return;
   const fs::path work = root / ".out.evfs-video-work";
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (!fs::exists(work / "windows" / "000002.json") &&
-         std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  ASSERT_TRUE(fs::exists(work / "windows" / "000002.json")) << "no window finished";
-  ASSERT_EQ(kill(pid, SIGINT), 0);
-  int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before the signal: make it longer";
 
   // The stale frames: those the interrupted run wrote from the recording as it was.
   std::vector<std::pair<fs::path, std::string>> stale;
@@ -295,6 +295,44 @@ TEST(EvfsVideo, ResumeWithOtherSettingsIsRefused) {
   EXPECT_FALSE(fs::exists(out));
   // Kept: the run it belongs to can still be resumed with its own settings.
   EXPECT_TRUE(fs::exists(work / ".evfs-video-work"));
+}
+
+// --event_model=FILE.json is part of the settings by its bytes, not its path: a calibration
+// file rewritten in place between the interrupted run and --resume refuses the resume; with
+// its first bytes back, the same run resumes.
+TEST(EvfsVideo, ResumeNoticesACalibrationFileChangedInPlace) {
+  const fs::path root = test::ScratchDir("video_resume_model_file");
+  fs::remove_all(root);
+  const std::string data = WriteSyntheticFolder(root.string(), 31, 4, 64, 48);
+  const fs::path model = root / "model.json";
+  const auto write_model = [&model](double threshold_on) {
+    test::WriteFile(model.string(),
+                    "{\"evfs_calibration\": 1, \"log_offset\": {\"value\": 0.1}, "
+                    "\"threshold_on\": {\"value\": " +
+                        std::to_string(threshold_on) + "}, \"threshold_off\": {\"value\": 0.2}}\n");
+  };
+  write_model(0.2);
+  const fs::path out = root / "out";
+  const std::vector<std::string> arguments = {
+      "video",    "--data=" + data, "--out=" + out.string(),          "--fps=500",
+      "--jobs=1", "--threads=1",    "--event_model=" + model.string()};
+  InterruptAfterWindow(arguments, root, "000000.json");
+  if (HasFatalFailure()) return;
+
+  const std::string resume =
+      "video --data=" + data + " --out=" + out.string() +
+      " --fps=500 --jobs=1 --threads=1 --resume --event_model=" + model.string();
+  write_model(0.3);  // same path, other thresholds
+  const CommandResult refused = RunEvfs(resume);
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.errors.find("other settings"), std::string::npos) << refused.errors;
+  EXPECT_FALSE(fs::exists(out));
+
+  write_model(0.2);
+  const CommandResult resumed = RunEvfs(resume);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_GE(summary["run"]["windows_resumed"].get<int>(), 1);
 }
 
 TEST(EvfsVideo, AWorkFolderPathEvfsDidNotMarkIsNeverTouched) {
