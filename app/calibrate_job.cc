@@ -146,6 +146,7 @@ void PrintInfoCalibration(const DataSource& source, const std::string& data_path
   request.first = first;
   request.last = last;
   request.max_frames = kInfoCalibrationFrames;
+  request.options.max_fit_pixels = kInfoCalibrationPixels;
   request.estimate_frame_lag = false;
   CalibrateResult result;
   try {

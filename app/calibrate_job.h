@@ -47,7 +47,8 @@ CalibrateResult RunCalibration(const DataSource& source, const CalibrateRequest&
 
 /// `evfs info`'s section on the event model: b, C_on, C_off, their spread and the background
 /// rate, each with its standard error, calibrated on frames first..last but no more than the
-/// first kInfoCalibrationFrames of them (the section says which), without the frame lag; or
+/// first kInfoCalibrationFrames of them (the section says which) and kInfoCalibrationPixels
+/// pixels, without the frame lag; or
 /// one line saying why the recording cannot tell. `first`/`last` as in CalibrateRequest.
 void PrintInfoCalibration(const DataSource& source, const std::string& data_path, int first,
                           int last, std::FILE* out);
@@ -55,6 +56,9 @@ void PrintInfoCalibration(const DataSource& source, const std::string& data_path
 /// Frames `evfs info` calibrates on at most: few enough that the section costs about one
 /// small calibration (well under a second at 240x180) whatever the recording's length.
 constexpr int kInfoCalibrationFrames = 3;
+/// Pixels `evfs info` fits at most (EventModelCalibrationOptions::max_fit_pixels), so that a
+/// large sensor costs it no more than a 240x180 one.
+constexpr int kInfoCalibrationPixels = 20000;
 
 /// A fingerprint of a calibration file's bytes (FNV-1a, hexadecimal), for `video --resume` to
 /// notice a file changed in place; "unreadable" when it cannot be read.

@@ -214,7 +214,8 @@ bool EventModelCalibrationOptions::IsValid(std::string* error) const {
       .Require(max_log_offset > min_log_offset, "max_log_offset", "above min_log_offset")
       .Require(max_threshold > min_threshold, "max_threshold", "above min_threshold")
       .Require(!log_offset_starts.empty(), "log_offset_starts", "not empty")
-      .InRange("min_pixels", min_pixels, 1, 1 << 30);
+      .InRange("min_pixels", min_pixels, 1, 1 << 30)
+      .InRange("max_fit_pixels", max_fit_pixels, 0, 1 << 30);
   return check.Passed(error);
 }
 
@@ -316,6 +317,12 @@ EventModelCalibration CalibrateEventModel(const std::vector<Image>& frames,
 
   EventModelCalibration result;
   result.thresholds_tied = with_on < options.min_pixels || with_off < options.min_pixels;
+  if (options.max_fit_pixels > 0 && runs.size() > static_cast<size_t>(options.max_fit_pixels)) {
+    const size_t stride = (runs.size() + options.max_fit_pixels - 1) / options.max_fit_pixels;
+    size_t kept = 0;
+    for (size_t i = 0; i < runs.size(); i += stride) runs[kept++] = std::move(runs[i]);
+    runs.resize(kept);
+  }
 
   // One problem; each start of b solves it again from its own values.
   double log_offset = 0.0;

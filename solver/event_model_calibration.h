@@ -60,6 +60,9 @@ struct EventModelCalibrationOptions {
   /// fraction of the smaller threshold between the frames: its events there are background
   /// (leak, shot noise, hot pixels), not the scene's.
   double quiet_fraction = 0.05;
+  /// At most this many pixels (runs of usable frames) enter the fit, >= 0; more are thinned to
+  /// every k-th, in raster order. 0: all. The standard errors are those of the pixels fitted.
+  int max_fit_pixels = 0;
 
   bool IsValid(std::string* error) const;
 };

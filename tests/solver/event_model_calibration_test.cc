@@ -165,6 +165,26 @@ TEST(CalibrateEventModel, MeasuresTheThresholdSpread) {
               kSpreadTolerance * sensor.threshold_sigma);
 }
 
+// A cap on the pixels fitted (evfs info's) thins them and still finds the thresholds; the
+// counts it reports are those of the pixels fitted.
+TEST(CalibrateEventModel, AThinnedFitFindsTheSameThresholds) {
+  SimulatorOptions sensor;
+  sensor.log_eps = 0.1;
+  const Recording recording = Simulate(sensor);
+  const EventModelCalibration all = recording.Calibrate();
+  EventModelCalibrationOptions thinned_options;
+  thinned_options.max_fit_pixels = all.pixels_used / 4;
+  const EventModelCalibration thinned = recording.Calibrate(thinned_options);
+  SCOPED_TRACE(thinned.description);
+  EXPECT_LE(thinned.pixels_used, thinned_options.max_fit_pixels);
+  EXPECT_GT(thinned.pixels_used, thinned_options.max_fit_pixels / 2);
+  EXPECT_NEAR(thinned.threshold_on.value, all.threshold_on.value,
+              kRelativeTolerance * all.threshold_on.value);
+  EXPECT_NEAR(thinned.threshold_off.value, all.threshold_off.value,
+              kRelativeTolerance * all.threshold_off.value);
+  EXPECT_GT(thinned.threshold_on.standard_error, all.threshold_on.standard_error);
+}
+
 TEST(CalibrateEventModel, MeasuresTheBackgroundRate) {
   SimulatorOptions sensor;
   sensor.log_eps = 0.01;
