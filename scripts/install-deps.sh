@@ -19,8 +19,7 @@ packages=(
   libflatbuffers-dev flatbuffers-compiler liblz4-dev libzstd-dev libtinyxml2-dev
   python3-lz4 python3-zstandard python3-flatbuffers
   # ROS 1 bags: rosbag_storage reads the container (its bag.h includes pluginlib); python3-rosbag
-  # writes the test bags
-  # (tests/io/write_rosbag.py) independently of evfs.
+  # writes the test bags (tests/io/write_rosbag.py) independently of evfs.
   librosbag-storage-dev pluginlib-dev python3-rosbag python3-pil
   # benchmarks/plot_methods.py: method_benchmark's PSNR-against-time plots.
   python3-matplotlib
