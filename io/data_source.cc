@@ -25,6 +25,13 @@ DataSource::DataSource(std::string path, int width, int height, std::vector<Fram
 
 DataSource::~DataSource() = default;
 
+void DataSource::CheckFrameIndex(int index) const {
+  if (index < 0 || index >= static_cast<int>(frames_.size())) {
+    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
+                               std::to_string(frames_.size()) + ")");
+  }
+}
+
 bool IsHdf5Path(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),

@@ -100,6 +100,8 @@ class DataSource {
 
  protected:
   DataSource(std::string path, int width, int height, std::vector<FrameInfo> frames);
+  /// Throws InvalidArgumentError unless `index` names a frame of frames() (ReadImage's check).
+  void CheckFrameIndex(int index) const;
 
   std::string path_;
   int width_ = 0;

@@ -591,10 +591,7 @@ const std::string& AedatLegacyDataSource::sensor_size_source() const {
 int64_t AedatLegacyDataSource::units_decoded() const { return file_->units_decoded(); }
 
 Image AedatLegacyDataSource::ReadImage(int index) const {
-  if (index < 0 || index >= static_cast<int>(frames_.size())) {
-    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
-                               std::to_string(frames_.size()) + ")");
-  }
+  CheckFrameIndex(index);
   return file_->ReadImage(index);
 }
 

@@ -1,10 +1,12 @@
 #include "io/rosbag/format.h"
 
 #include <cstring>
+#include <map>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -47,19 +49,21 @@ struct Record {
 
 class BagChecker {
  public:
-  BagChecker(const std::string& path, const uint8_t* data, size_t size)
-      : path_(path), data_(data), size_(size) {}
+  // `context` opens every message: "" for the file, "the chunk at byte N, uncompressed, " for
+  // the bytes of a chunk.
+  BagChecker(const std::string& path, const uint8_t* data, size_t size, std::string context = "")
+      : path_(path), data_(data), size_(size), context_(std::move(context)) {}
 
-  void Check() {
+  BagLayout Check() {
     if (size_ < kMagicBytes || std::memcmp(data_, kMagic, kMagicBytes) != 0) {
       Fail(0, "does not start with \"#ROSBAG V2.0\" (not a ROS 1 bag of version 2.0)");
     }
     std::vector<Record> records;
-    std::set<size_t> record_offsets;
+    std::map<size_t, size_t> record_at_offset;
     for (size_t offset = kMagicBytes; offset < size_;) {
       const Record record = ReadRecord(offset, size_, "the file");
+      record_at_offset[offset] = records.size();
       records.push_back(record);
-      record_offsets.insert(offset);
       offset = record.data_end;
     }
     if (records.empty() || records.front().op != kOpBagHeader) {
@@ -75,18 +79,19 @@ class BagChecker {
            "'rosbag reindex' first");
     }
     // The index: conn_count connections, then chunk_count chunk infos.
-    size_t at = 0;
-    while (at < records.size() && records[at].offset != index_pos) ++at;
-    if (at == records.size()) {
+    const auto index = record_at_offset.find(index_pos);
+    if (index == record_at_offset.end()) {
       Fail(bag_header.offset, "index_pos " + std::to_string(index_pos) +
                                   " is not the start of a record (truncated file?)");
     }
+    const size_t at = index->second;
     if (records.size() - at < static_cast<uint64_t>(conn_count) + chunk_count) {
       Fail(index_pos, "the index holds fewer than the " + std::to_string(conn_count) +
                           " connections and " + std::to_string(chunk_count) +
                           " chunk infos the bag header declares (truncated file?)");
     }
     std::set<uint32_t> connections;
+    BagLayout layout;
     for (uint32_t i = 0; i < conn_count; ++i) {
       const Record& record = records[at + i];
       Expect(record, kOpConnection, "a connection record");
@@ -109,24 +114,55 @@ class BagChecker {
         CheckConnection(connections, ReadU32(data_ + info.data_begin + k * kChunkInfoEntryBytes),
                         info.offset);
       }
-      size_t chunk = 0;
-      while (chunk < at && records[chunk].offset != chunk_pos) ++chunk;
-      if (chunk == at) {
+      const auto chunk_record = record_at_offset.find(chunk_pos);
+      if (chunk_record == record_at_offset.end() || chunk_record->second >= at) {
         Fail(info.offset, "a chunk info points at byte " + std::to_string(chunk_pos) +
                               ", where no chunk starts");
       }
       // rosbag_storage reads `count` index data records after the chunk.
+      const size_t chunk = chunk_record->second;
       if (chunk + count >= at) {
         Fail(chunk_pos, "a chunk without the index data its chunk info declares");
       }
-      CheckChunk(records, chunk, count, connections);
+      layout.chunks.push_back(CheckChunk(records, chunk, count, connections));
+    }
+    return layout;
+  }
+
+  // The uncompressed bytes of `chunk` (this checker's data): every record inside it, and a
+  // message record wherever its index data points.
+  void CheckChunkRecords(const BagChunk& chunk) const {
+    if (size_ != chunk.size) {
+      Fail(0, "the chunk holds " + std::to_string(size_) +
+                  " bytes uncompressed, its size field says " + std::to_string(chunk.size));
+    }
+    std::set<size_t> messages;
+    for (size_t at = 0; at < size_;) {
+      const Record inner = ReadRecord(at, size_, "its chunk");
+      if (inner.op == kOpMessageData) {
+        FieldU32(inner, "conn");
+        FieldU64(inner, "time");
+        messages.insert(at);
+      } else if (inner.op == kOpConnection) {
+        FieldU32(inner, "conn");
+        Field(inner, "topic");
+        CheckFields(inner.data_begin, inner.data_end);
+      } else {
+        Fail(at, "a record of op " + std::to_string(inner.op) + " inside a chunk");
+      }
+      at = inner.data_end;
+    }
+    for (const BagChunk::Entry& entry : chunk.entries) {
+      if (messages.count(entry.offset) == 0) {
+        Fail(entry.offset, "the chunk's index points here, where no message starts");
+      }
     }
   }
 
  private:
   [[noreturn]] void Fail(size_t offset, const std::string& what) const {
     throw InputError(InputError::Kind::kMalformed, path_, 0,
-                     "byte " + std::to_string(offset) + ": " + what);
+                     context_ + "byte " + std::to_string(offset) + ": " + what);
   }
 
   // The record at `offset`, which must end by `end`.
@@ -204,62 +240,66 @@ class BagChecker {
     }
   }
 
-  // The chunk records[chunk] and the `count` index data records after it.
-  void CheckChunk(const std::vector<Record>& records, size_t chunk, uint32_t count,
-                  const std::set<uint32_t>& connections) const {
+  // The chunk records[chunk] and the `count` index data records after it. Its records are
+  // checked when it is first read (CheckChunkRecords): a compressed one only decompressed shows
+  // them.
+  BagChunk CheckChunk(const std::vector<Record>& records, size_t chunk, uint32_t count,
+                      const std::set<uint32_t>& connections) const {
     const Record& record = records[chunk];
-    if (record.op != kOpChunk)
+    if (record.op != kOpChunk) {
       Fail(record.offset, "a chunk info points at a record that is no chunk");
-    const std::string compression = Field(record, "compression");
-    const uint32_t size = FieldU32(record, "size");
-    std::set<size_t> messages;  // offsets of the message records of an uncompressed chunk
-    if (compression == "none") {
-      if (record.data_end - record.data_begin != size) {
-        Fail(record.offset, "an uncompressed chunk whose size field differs from its data");
-      }
-      for (size_t at = record.data_begin; at < record.data_end;) {
-        const Record inner = ReadRecord(at, record.data_end, "its chunk");
-        if (inner.op == kOpMessageData) {
-          CheckConnection(connections, FieldU32(inner, "conn"), at);
-          FieldU64(inner, "time");
-          messages.insert(at - record.data_begin);
-        } else if (inner.op == kOpConnection) {
-          FieldU32(inner, "conn");
-          Field(inner, "topic");
-          CheckFields(inner.data_begin, inner.data_end);
-        } else {
-          Fail(at, "a record of op " + std::to_string(inner.op) + " inside a chunk");
-        }
-        at = inner.data_end;
-      }
-    } else if (compression != "bz2" && compression != "lz4") {
-      Fail(record.offset, "a chunk compressed with '" + compression +
+    }
+    BagChunk layout;
+    layout.offset = record.offset;
+    layout.data_begin = record.data_begin;
+    layout.data_size = record.data_end - record.data_begin;
+    layout.compression = Field(record, "compression");
+    layout.size = FieldU32(record, "size");
+    if (layout.compression == "none" && layout.data_size != layout.size) {
+      Fail(record.offset, "an uncompressed chunk whose size field differs from its data");
+    }
+    if (layout.compression != "none" && layout.compression != "bz2" &&
+        layout.compression != "lz4") {
+      Fail(record.offset, "a chunk compressed with '" + layout.compression +
                               "' (rosbag_storage reads none, bz2 and lz4)");
+    }
+    if (layout.size > kMaxChunkBytes) {
+      Fail(record.offset, "a chunk of " + std::to_string(layout.size) + " bytes, more than the " +
+                              std::to_string(kMaxChunkBytes) + " evfs reads");
     }
     for (uint32_t i = 1; i <= count; ++i) {
       const Record& index = records[chunk + i];
       if (index.op != kOpIndexData) Fail(index.offset, "expected index data after a chunk");
       if (FieldU32(index, "ver") != 1) Fail(index.offset, "index data of a version other than 1");
-      CheckConnection(connections, FieldU32(index, "conn"), index.offset);
+      const uint32_t connection = FieldU32(index, "conn");
+      CheckConnection(connections, connection, index.offset);
       const uint32_t entries = FieldU32(index, "count");
       if (index.data_end - index.data_begin != static_cast<uint64_t>(entries) * kIndexEntryBytes) {
         Fail(index.offset,
              "index data whose size does not hold its " + std::to_string(entries) + " entries");
       }
       for (uint32_t k = 0; k < entries; ++k) {
-        const uint32_t offset = ReadU32(data_ + index.data_begin + k * kIndexEntryBytes + 8);
-        const bool fits = compression == "none" ? messages.count(offset) == 1 : offset < size;
-        if (!fits) {
-          Fail(index.offset, "index entry " + std::to_string(k) + " points at chunk byte " +
-                                 std::to_string(offset) + ", where no message starts");
+        const uint8_t* entry = data_ + index.data_begin + k * kIndexEntryBytes;
+        const uint32_t sec = ReadU32(entry), nsec = ReadU32(entry + 4);
+        if (nsec >= kNanosecondsPerSecond) {
+          Fail(index.offset, "index entry " + std::to_string(k) + ": a time with nsec >= 1e9");
         }
+        const uint32_t offset = ReadU32(entry + 8);
+        if (offset >= layout.size) {
+          Fail(index.offset, "index entry " + std::to_string(k) + " points at chunk byte " +
+                                 std::to_string(offset) + ", past the chunk's end");
+        }
+        layout.entries.push_back(
+            {connection, uint64_t{sec} * kNanosecondsPerSecond + nsec, offset});
       }
     }
+    return layout;
   }
 
   const std::string& path_;
   const uint8_t* data_;
   size_t size_;
+  std::string context_;
 };
 
 // Reads a serialised message field by field, failing on a short message.
@@ -310,8 +350,15 @@ class MessageReader {
 
 }  // namespace
 
-void CheckBagStructure(const std::string& path, const uint8_t* data, size_t size) {
-  BagChecker(path, data, size).Check();
+BagLayout CheckBagStructure(const std::string& path, const uint8_t* data, size_t size) {
+  return BagChecker(path, data, size).Check();
+}
+
+void CheckChunkRecords(const std::string& path, const BagChunk& chunk, const uint8_t* data,
+                       size_t size) {
+  BagChecker(path, data, size,
+             "the chunk at byte " + std::to_string(chunk.offset) + ", uncompressed, ")
+      .CheckChunkRecords(chunk);
 }
 
 int64_t EventArray::t_ns(uint32_t index) const {

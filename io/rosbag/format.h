@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/video.h"
 
@@ -34,14 +35,44 @@ constexpr size_t kMagicBytes = sizeof(kMagic) - 1;
 constexpr char kEventArrayType[] = "dvs_msgs/EventArray";
 constexpr char kImageType[] = "sensor_msgs/Image";
 
+/// Most bytes of one chunk uncompressed evfs reads (rosbag_storage allocates what the chunk
+/// declares; rosbag record writes 768 KiB chunks by default).
+constexpr uint32_t kMaxChunkBytes = 1u << 30;
+
+/// One chunk of a bag and its index data, as CheckBagStructure found them.
+struct BagChunk {
+  size_t offset = 0;      // of the chunk record in the file
+  size_t data_begin = 0;  // its data (compressed unless compression is "none") in the file
+  size_t data_size = 0;
+  std::string compression;  // "none", "bz2" or "lz4"
+  uint32_t size = 0;        // uncompressed
+  /// One index entry: a message of `connection` received at `time_ns`, at chunk byte `offset`.
+  struct Entry {
+    uint32_t connection;
+    uint64_t time_ns;
+    uint32_t offset;
+  };
+  std::vector<Entry> entries;
+};
+
+struct BagLayout {
+  std::vector<BagChunk> chunks;  // in the order of the chunk infos
+};
+
 /// Walks the records of the `size` bytes at `data` (the bag `path`, for messages) and checks
-/// everything rosbag_storage relies on without checking it: every record and header field lies
-/// inside the file, the bag header's index position falls on a record, every chunk info points
-/// at a chunk, and every offset in a chunk's index data lies inside the chunk (inside an
-/// uncompressed chunk, on a whole message record). Throws InputError naming the byte offset
-/// where the file stops making sense, and for an unindexed bag (index_pos 0: a recording that
-/// was cut short).
-void CheckBagStructure(const std::string& path, const uint8_t* data, size_t size);
+/// everything rosbag_storage relies on without checking it when it opens a bag: every record
+/// and header field lies inside the file, the bag header's index position falls on a record,
+/// the index holds the connections and chunk infos the header declares, every chunk info points
+/// at a chunk followed by its index data, every connection named is declared and every index
+/// offset lies inside its chunk. Throws InputError naming the byte offset where the file stops
+/// making sense, and for an unindexed bag (index_pos 0: a recording that was cut short).
+BagLayout CheckBagStructure(const std::string& path, const uint8_t* data, size_t size);
+
+/// Checks the `size` bytes at `data`, `chunk` uncompressed, before rosbag_storage reads its
+/// messages (it trusts the lengths it finds there): they are `chunk.size` bytes of whole records,
+/// and every index entry of the chunk points at a message record. Throws InputError.
+void CheckChunkRecords(const std::string& path, const BagChunk& chunk, const uint8_t* data,
+                       size_t size);
 
 /// The header and event count of a dvs_msgs/EventArray; the events stay in the message bytes.
 struct EventArray {

@@ -1,10 +1,12 @@
 // Reading ROS 1 bags: RosbagDataSource (io/rosbag.h).
+#include <bzlib.h>
 #include <console_bridge/console.h>
 #include <ros/serialization.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
 #include <rosbag/query.h>
 #include <rosbag/view.h>
+#include <roslz4/lz4s.h>
 
 #include <algorithm>
 #include <cctype>
@@ -14,6 +16,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -83,13 +87,11 @@ bool StartsWithRosbagMagic(const std::string& path) {
 
 class RosbagDataSource::File {
  public:
-  File(const std::string& path, const DataSourceOptions& options) : path_(path) {
+  File(const std::string& path, const DataSourceOptions& options) : path_(path), file_(path) {
     // rosbag_storage logs through console_bridge; evfs reports its errors itself, in one line.
     console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
-    {
-      const MappedFile file(path);
-      rf::CheckBagStructure(path, reinterpret_cast<const uint8_t*>(file.data()), file.size());
-    }
+    layout_ = rf::CheckBagStructure(path, bytes(), file_.size());
+    chunk_checked_.assign(layout_.chunks.size(), false);
     Guard([&] { bag_.open(path, rosbag::bagmode::Read); });
     Guard([&] { ListTopics(); });
     events_topic_ =
@@ -142,6 +144,7 @@ class RosbagDataSource::File {
     const FrameMessage& frame = frame_messages_[static_cast<size_t>(index)];
     Image image;
     Guard([&] {
+      CheckChunks(frames_topic_, frame.receive_time, frame.receive_time);
       rosbag::View view(bag_, rosbag::TopicQuery(frames_topic_), frame.receive_time,
                         frame.receive_time);
       int ordinal = 0;
@@ -191,6 +194,7 @@ class RosbagDataSource::File {
       bool any = false;
       int64_t first_t_ns = 0, last_t_ns = 0;
       Guard([&] {
+        CheckChunks(events_topic_, from, to);
         rosbag::View view(bag_, rosbag::TopicQuery(events_topic_), from, to);
         int64_t previous_t_ns = std::numeric_limits<int64_t>::min();
         for (const rosbag::MessageInstance& message : view) {
@@ -248,6 +252,53 @@ class RosbagDataSource::File {
     int ordinal = 0;
   };
 
+  const uint8_t* bytes() const { return reinterpret_cast<const uint8_t*>(file_.data()); }
+
+  // Checks, once each, the chunks holding messages of `topic` received in [from, to] (the
+  // messages a rosbag::View on them reads), decompressing them: rosbag_storage trusts the record
+  // lengths inside a chunk.
+  void CheckChunks(const std::string& topic, const ros::Time& from, const ros::Time& to) const {
+    const std::set<uint32_t>& connections = topic_connections_.at(topic);
+    for (size_t i = 0; i < layout_.chunks.size(); ++i) {
+      const rf::BagChunk& chunk = layout_.chunks[i];
+      if (chunk_checked_[i]) continue;
+      const bool read = std::any_of(
+          chunk.entries.begin(), chunk.entries.end(), [&](const rf::BagChunk::Entry& entry) {
+            return connections.count(entry.connection) == 1 && entry.time_ns >= from.toNSec() &&
+                   entry.time_ns <= to.toNSec();
+          });
+      if (!read) continue;
+      if (chunk.compression == "none") {
+        rf::CheckChunkRecords(path_, chunk, bytes() + chunk.data_begin, chunk.data_size);
+      } else {
+        const std::vector<uint8_t> uncompressed = Decompress(chunk);
+        rf::CheckChunkRecords(path_, chunk, uncompressed.data(), uncompressed.size());
+      }
+      chunk_checked_[i] = true;
+    }
+  }
+
+  // The data of a bz2 or LZ4 chunk uncompressed, as rosbag_storage decompresses it.
+  std::vector<uint8_t> Decompress(const rf::BagChunk& chunk) const {
+    std::vector<uint8_t> out(chunk.size);
+    char* input = const_cast<char*>(reinterpret_cast<const char*>(bytes() + chunk.data_begin));
+    unsigned int length = chunk.size;
+    const bool ok =
+        chunk.compression == "bz2"
+            ? BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(out.data()), &length, input,
+                                         static_cast<unsigned int>(chunk.data_size), 0, 0) == BZ_OK
+            : roslz4_buffToBuffDecompress(input, static_cast<unsigned int>(chunk.data_size),
+                                          reinterpret_cast<char*>(out.data()),
+                                          &length) == ROSLZ4_OK;
+    if (!ok) {
+      Fail(InputError::Kind::kMalformed, "byte " + std::to_string(chunk.offset) + ": a " +
+                                             chunk.compression +
+                                             " chunk that does not decompress (corrupt?)");
+    }
+    out.resize(length);
+    return out;
+  }
+
   std::string MessageName(const std::string& topic, const ros::Time& time) const {
     char seconds[32];
     std::snprintf(seconds, sizeof(seconds), "%u.%09u", time.sec, time.nsec);
@@ -265,6 +316,7 @@ class RosbagDataSource::File {
   void ListTopics() {
     rosbag::View view(bag_);
     for (const rosbag::ConnectionInfo* connection : view.getConnections()) {
+      topic_connections_[connection->topic].insert(connection->id);
       const bool known = std::any_of(topics_.begin(), topics_.end(), [&](const RosbagTopic& t) {
         return t.name == connection->topic;
       });
@@ -320,6 +372,7 @@ class RosbagDataSource::File {
       FrameMessage message;
     };
     std::vector<Stamped> stamped;
+    CheckChunks(frames_topic_, ros::TIME_MIN, ros::TIME_MAX);
     rosbag::View view(bag_, rosbag::TopicQuery(frames_topic_));
     ros::Time previous_time;
     int ordinal = 0;
@@ -358,6 +411,7 @@ class RosbagDataSource::File {
       rosbag::View view(bag_, rosbag::TopicQuery(events_topic_));
       events_begin_ = view.getBeginTime();
       events_end_ = view.getEndTime();
+      CheckChunks(events_topic_, ros::TIME_MIN, events_begin_);
       for (const rosbag::MessageInstance& message : view) {
         const std::string where = MessageName(events_topic_, message.getTime());
         const std::vector<uint8_t>& bytes = Bytes(message);
@@ -383,8 +437,12 @@ class RosbagDataSource::File {
   }
 
   std::string path_;
+  MappedFile file_;  // the bag, for the checks of its structure and its chunks
+  rf::BagLayout layout_;
+  mutable std::vector<bool> chunk_checked_;  // as layout_.chunks
   rosbag::Bag bag_;
   std::vector<RosbagTopic> topics_;
+  std::map<std::string, std::set<uint32_t>> topic_connections_;
   std::vector<std::string> md5sums_;  // of the first connection of each topic
   std::string events_topic_, frames_topic_;
   std::string events_reason_, frames_reason_;
@@ -423,10 +481,7 @@ const std::vector<RosbagTopic>& RosbagDataSource::topics() const { return file_-
 int64_t RosbagDataSource::messages_decoded() const { return file_->messages_decoded(); }
 
 Image RosbagDataSource::ReadImage(int index) const {
-  if (index < 0 || index >= static_cast<int>(frames_.size())) {
-    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
-                               std::to_string(frames_.size()) + ")");
-  }
+  CheckFrameIndex(index);
   return file_->ReadImage(index);
 }
 
