@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/message_excerpt.h"
 
 namespace evfs {
 namespace rosbag_format {
@@ -260,7 +261,7 @@ class BagChecker {
     }
     if (layout.compression != "none" && layout.compression != "bz2" &&
         layout.compression != "lz4") {
-      Fail(record.offset, "a chunk compressed with '" + layout.compression +
+      Fail(record.offset, "a chunk compressed with '" + MessageExcerpt(layout.compression) +
                               "' (rosbag_storage reads none, bz2 and lz4)");
     }
     if (layout.size > kMaxChunkBytes) {
@@ -437,7 +438,7 @@ Image ImageToGrey(const ImageMessage& image, const std::string& where) {
   }
   if (encoding == nullptr) {
     throw InputError(InputError::Kind::kMalformed, where, 0,
-                     "image encoding '" + image.encoding +
+                     "image encoding '" + MessageExcerpt(image.encoding) +
                          "' (evfs reads mono8, mono16, rgb8, bgr8, rgba8 and bgra8)");
   }
   const uint64_t row_bytes =
@@ -447,8 +448,8 @@ Image ImageToGrey(const ImageMessage& image, const std::string& where) {
       image.pixel_bytes < uint64_t{image.step} * (image.height - 1) + row_bytes) {
     throw InputError(InputError::Kind::kMalformed, where, 0,
                      "a " + std::to_string(image.width) + "x" + std::to_string(image.height) + " " +
-                         image.encoding + " image with step " + std::to_string(image.step) +
-                         " and " + std::to_string(image.pixel_bytes) +
+                         MessageExcerpt(image.encoding) + " image with step " +
+                         std::to_string(image.step) + " and " + std::to_string(image.pixel_bytes) +
                          " bytes of data, which do not fit");
   }
   const int rows = static_cast<int>(image.height);

@@ -17,12 +17,14 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 #include <utility>
 #include <vector>
 
 #include "core/error.h"
 #include "io/mapped_file.h"
+#include "io/message_excerpt.h"
 #include "io/rosbag.h"
 #include "io/rosbag/format.h"
 
@@ -92,7 +94,10 @@ class RosbagDataSource::File {
     console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
     layout_ = rf::CheckBagStructure(path, bytes(), file_.size());
     chunk_checked_.assign(layout_.chunks.size(), false);
-    Guard([&] { bag_.open(path, rosbag::bagmode::Read); });
+    Guard([&] {
+      bag_ = std::make_unique<rosbag::Bag>();
+      bag_->open(path, rosbag::bagmode::Read);
+    });
     Guard([&] { ListTopics(); });
     events_topic_ =
         ChooseTopic(options.events_topic, "--events_topic", rf::kEventArrayType, kEventArrayMd5);
@@ -101,10 +106,11 @@ class RosbagDataSource::File {
       Fail(InputError::Kind::kMalformed, "no " + std::string(rf::kEventArrayType) + " or " +
                                              rf::kImageType + " topic in the bag");
     }
-    topic_choice_ = (events_topic_.empty() ? "no events" : "events from " + events_topic_) +
-                    events_reason_ + ", " +
-                    (frames_topic_.empty() ? "no frames" : "frames from " + frames_topic_) +
-                    frames_reason_;
+    topic_choice_ =
+        (events_topic_.empty() ? "no events" : "events from " + MessageExcerpt(events_topic_)) +
+        events_reason_ + ", " +
+        (frames_topic_.empty() ? "no frames" : "frames from " + MessageExcerpt(frames_topic_)) +
+        frames_reason_;
     Guard([&] {
       IndexFrames();
       IndexEvents();
@@ -134,9 +140,7 @@ class RosbagDataSource::File {
     } catch (const Error&) {
       throw;
     } catch (const std::exception& error) {
-      std::string what = error.what();
-      std::replace(what.begin(), what.end(), '\n', ' ');
-      Fail(InputError::Kind::kMalformed, "rosbag_storage: " + what);
+      Fail(InputError::Kind::kMalformed, "rosbag_storage: " + MessageExcerpt(error.what()));
     }
   }
 
@@ -145,7 +149,7 @@ class RosbagDataSource::File {
     Image image;
     Guard([&] {
       CheckChunks(frames_topic_, frame.receive_time, frame.receive_time);
-      rosbag::View view(bag_, rosbag::TopicQuery(frames_topic_), frame.receive_time,
+      rosbag::View view(*bag_, rosbag::TopicQuery(frames_topic_), frame.receive_time,
                         frame.receive_time);
       int ordinal = 0;
       for (const rosbag::MessageInstance& message : view) {
@@ -164,7 +168,8 @@ class RosbagDataSource::File {
         return;
       }
       Fail(InputError::Kind::kMalformed, "frame " + std::to_string(index) + " is gone from " +
-                                             frames_topic_ + " (the index changed?)");
+                                             MessageExcerpt(frames_topic_) +
+                                             " (the index changed?)");
     });
     return image;
   }
@@ -195,7 +200,7 @@ class RosbagDataSource::File {
       int64_t first_t_ns = 0, last_t_ns = 0;
       Guard([&] {
         CheckChunks(events_topic_, from, to);
-        rosbag::View view(bag_, rosbag::TopicQuery(events_topic_), from, to);
+        rosbag::View view(*bag_, rosbag::TopicQuery(events_topic_), from, to);
         int64_t previous_t_ns = std::numeric_limits<int64_t>::min();
         for (const rosbag::MessageInstance& message : view) {
           ++messages_decoded_;
@@ -302,7 +307,7 @@ class RosbagDataSource::File {
   std::string MessageName(const std::string& topic, const ros::Time& time) const {
     char seconds[32];
     std::snprintf(seconds, sizeof(seconds), "%u.%09u", time.sec, time.nsec);
-    return path_ + " (" + topic + ", message received at " + seconds + " s)";
+    return path_ + " (" + MessageExcerpt(topic) + ", message received at " + seconds + " s)";
   }
 
   // The serialised message, copied into buffer_.
@@ -314,7 +319,7 @@ class RosbagDataSource::File {
   }
 
   void ListTopics() {
-    rosbag::View view(bag_);
+    rosbag::View view(*bag_);
     for (const rosbag::ConnectionInfo* connection : view.getConnections()) {
       topic_connections_[connection->topic].insert(connection->id);
       const bool known = std::any_of(topics_.begin(), topics_.end(), [&](const RosbagTopic& t) {
@@ -324,7 +329,7 @@ class RosbagDataSource::File {
       RosbagTopic topic;
       topic.name = connection->topic;
       topic.datatype = connection->datatype;
-      topic.messages = rosbag::View(bag_, rosbag::TopicQuery(topic.name)).size();
+      topic.messages = rosbag::View(*bag_, rosbag::TopicQuery(topic.name)).size();
       topics_.push_back(topic);
       md5sums_.push_back(connection->md5sum);
     }
@@ -339,10 +344,11 @@ class RosbagDataSource::File {
       const RosbagTopic& topic = topics_[i];
       if (named.empty() ? topic.datatype != datatype : topic.name != named) continue;
       if (topic.datatype != datatype || md5sums_[i] != md5sum) {
-        Fail(InputError::Kind::kMalformed, std::string(flag) + "=" + named +
-                                               ": the topic is of type " + topic.datatype +
-                                               " (md5sum " + md5sums_[i] + "), expected " +
-                                               datatype + " (md5sum " + md5sum + ")");
+        Fail(InputError::Kind::kMalformed,
+             (named.empty() ? std::string("topic ") : std::string(flag) + "=") +
+                 MessageExcerpt(topic.name) + ": of type " + MessageExcerpt(topic.datatype) +
+                 " (md5sum " + MessageExcerpt(md5sums_[i]) + "), expected " + datatype +
+                 " (md5sum " + md5sum + ")");
       }
       reason = named.empty() ? std::string(" (the first ") + datatype + " topic; " + flag +
                                    " chooses another)"
@@ -350,12 +356,17 @@ class RosbagDataSource::File {
       return topic.name;
     }
     if (!named.empty()) {
+      // A few of the bag's topics: a message stays one short line.
+      constexpr size_t kTopicsNamed = 4;
       std::string names;
-      for (const RosbagTopic& topic : topics_) {
-        names += (names.empty() ? "" : ", ") + topic.name + " (" + topic.datatype + ")";
+      for (size_t i = 0; i < topics_.size() && i < kTopicsNamed; ++i) {
+        names += (i == 0 ? "" : ", ") + MessageExcerpt(topics_[i].name);
       }
-      Fail(InputError::Kind::kMalformed,
-           std::string(flag) + "=" + named + ": no such topic; the bag has " + names);
+      if (topics_.size() > kTopicsNamed) {
+        names += " and " + std::to_string(topics_.size() - kTopicsNamed) + " more";
+      }
+      Fail(InputError::Kind::kMalformed, std::string(flag) + "=" + MessageExcerpt(named) +
+                                             ": no such topic; the bag has " + names);
     }
     return "";
   }
@@ -373,7 +384,7 @@ class RosbagDataSource::File {
     };
     std::vector<Stamped> stamped;
     CheckChunks(frames_topic_, ros::TIME_MIN, ros::TIME_MAX);
-    rosbag::View view(bag_, rosbag::TopicQuery(frames_topic_));
+    rosbag::View view(*bag_, rosbag::TopicQuery(frames_topic_));
     ros::Time previous_time;
     int ordinal = 0;
     for (const rosbag::MessageInstance& message : view) {
@@ -394,7 +405,7 @@ class RosbagDataSource::File {
     for (size_t i = 0; i < stamped.size(); ++i) {
       if (i > 0 && stamped[i].stamp_ns == stamped[i - 1].stamp_ns) {
         Fail(InputError::Kind::kNotMonotonic,
-             "two images on " + frames_topic_ + " have the same header stamp");
+             "two images on " + MessageExcerpt(frames_topic_) + " have the same header stamp");
       }
       FrameInfo frame;
       frame.t_ns = stamped[i].stamp_ns;
@@ -402,13 +413,14 @@ class RosbagDataSource::File {
       frames_.push_back(frame);
       frame_messages_.push_back(stamped[i].message);
     }
-    if (frames_.empty()) no_frames_reason_ = "the topic " + frames_topic_ + " holds no images";
+    if (frames_.empty())
+      no_frames_reason_ = "the topic " + MessageExcerpt(frames_topic_) + " holds no images";
   }
 
   // The sensor size and receive delays, from the first event array; the topic's time span.
   void IndexEvents() {
     if (!events_topic_.empty()) {
-      rosbag::View view(bag_, rosbag::TopicQuery(events_topic_));
+      rosbag::View view(*bag_, rosbag::TopicQuery(events_topic_));
       events_begin_ = view.getBeginTime();
       events_end_ = view.getEndTime();
       CheckChunks(events_topic_, ros::TIME_MIN, events_begin_);
@@ -440,7 +452,9 @@ class RosbagDataSource::File {
   MappedFile file_;  // the bag, for the checks of its structure and its chunks
   rf::BagLayout layout_;
   mutable std::vector<bool> chunk_checked_;  // as layout_.chunks
-  rosbag::Bag bag_;
+  // Made once the structure is checked: its constructor sets up pluginlib's loader of
+  // encryption plugins, which costs far more than checking a malformed file.
+  std::unique_ptr<rosbag::Bag> bag_;
   std::vector<RosbagTopic> topics_;
   std::map<std::string, std::set<uint32_t>> topic_connections_;
   std::vector<std::string> md5sums_;  // of the first connection of each topic

@@ -243,5 +243,30 @@ TEST(RosbagTest, TruncatedAndCorruptBagsAreInputErrors) {
   }
 }
 
+// A regression test from rosbag_fuzzer: a control byte in a field the message quotes (here the
+// chunk's compression) is written as \xNN, so the message stays one printable line.
+TEST(RosbagTest, MessagesQuoteTheFileWithoutControlBytes) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  EVFS_REQUIRE_PYTHON_ROSBAG();
+  const std::string bag = WriteBag(data_dir + "/slider_depth_70_71", "--compression lz4");
+  std::ifstream in(bag, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = bytes.find("compression=lz4");
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + std::string("compression=lz").size()] = '\x01';
+  const std::string broken = fs::path(bag).parent_path().string() + "/control.bag";
+  test::WriteFile(broken, bytes);
+  try {
+    RosbagDataSource source(broken);
+    FAIL() << "a chunk compressed with 'lz\\x01' was read";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("'lz\\x01'"), std::string::npos) << message;
+    EXPECT_TRUE(std::none_of(message.begin(), message.end(), [](char c) {
+      return static_cast<unsigned char>(c) < 0x20;
+    })) << message;
+  }
+}
+
 }  // namespace
 }  // namespace evfs
