@@ -16,6 +16,7 @@
 #include "io/aedat_legacy/format.h"
 #include "io/aedat_legacy/header.h"
 #include "io/mapped_file.h"
+#include "io/visited_events.h"
 
 namespace evfs {
 namespace aedat_legacy {
@@ -596,24 +597,17 @@ Image AedatLegacyDataSource::ReadImage(int index) const {
 }
 
 EventStream AedatLegacyDataSource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
-  EventStream events(width_, height_);
-  file_->ForEachEvent(t_begin_ns, t_end_ns, [&](int64_t t_ns, int x, int y, int polarity) {
-    events.push_back(t_ns, static_cast<uint16_t>(x), static_cast<uint16_t>(y),
-                     static_cast<int8_t>(polarity));
-  });
-  return events;
+  return CollectVisitedEvents(
+      width_, height_, [&](auto&& visit) { file_->ForEachEvent(t_begin_ns, t_end_ns, visit); });
 }
 
 EventStream AedatLegacyDataSource::ReadAllEvents() const {
-  return ReadEvents(std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+  return ReadEvents(kAllEventsBeginNs, kAllEventsEndNs);
 }
 
 EventSummary AedatLegacyDataSource::Summarize() const {
-  EventSummary summary;
-  file_->ForEachEvent(
-      std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max(),
-      [&](int64_t t_ns, int x, int y, int polarity) { summary.Add(t_ns, x, y, polarity); });
-  return summary;
+  return SummarizeVisitedEvents(
+      [&](auto&& visit) { file_->ForEachEvent(kAllEventsBeginNs, kAllEventsEndNs, visit); });
 }
 
 }  // namespace evfs

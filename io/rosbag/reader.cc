@@ -27,6 +27,7 @@
 #include "io/message_excerpt.h"
 #include "io/rosbag.h"
 #include "io/rosbag/format.h"
+#include "io/visited_events.h"
 
 namespace evfs {
 namespace {
@@ -179,8 +180,7 @@ class RosbagDataSource::File {
   void ForEachEvent(int64_t t_begin_ns, int64_t t_end_ns, Visitor&& visit) const {
     if (events_topic_.empty() || t_end_ns <= t_begin_ns) return;
     int64_t before_ns = kFirstQueryMarginNs, after_ns = kFirstQueryMarginNs;
-    const bool whole = t_begin_ns == std::numeric_limits<int64_t>::min() &&
-                       t_end_ns == std::numeric_limits<int64_t>::max();
+    const bool whole = t_begin_ns == kAllEventsBeginNs && t_end_ns == kAllEventsEndNs;
     for (;;) {
       const ros::Time from =
           whole ? ros::TIME_MIN
@@ -500,24 +500,17 @@ Image RosbagDataSource::ReadImage(int index) const {
 }
 
 EventStream RosbagDataSource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
-  EventStream events(width_, height_);
-  file_->ForEachEvent(t_begin_ns, t_end_ns, [&](int64_t t_ns, int x, int y, int polarity) {
-    events.push_back(t_ns, static_cast<uint16_t>(x), static_cast<uint16_t>(y),
-                     static_cast<int8_t>(polarity));
-  });
-  return events;
+  return CollectVisitedEvents(
+      width_, height_, [&](auto&& visit) { file_->ForEachEvent(t_begin_ns, t_end_ns, visit); });
 }
 
 EventStream RosbagDataSource::ReadAllEvents() const {
-  return ReadEvents(std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+  return ReadEvents(kAllEventsBeginNs, kAllEventsEndNs);
 }
 
 EventSummary RosbagDataSource::Summarize() const {
-  EventSummary summary;
-  file_->ForEachEvent(
-      std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max(),
-      [&](int64_t t_ns, int x, int y, int polarity) { summary.Add(t_ns, x, y, polarity); });
-  return summary;
+  return SummarizeVisitedEvents(
+      [&](auto&& visit) { file_->ForEachEvent(kAllEventsBeginNs, kAllEventsEndNs, visit); });
 }
 
 }  // namespace evfs
