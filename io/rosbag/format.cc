@@ -26,6 +26,10 @@ constexpr uint8_t kOpChunk = 0x05;
 constexpr uint8_t kOpChunkInfo = 0x06;
 constexpr uint8_t kOpConnection = 0x07;
 
+// The most LZ4 expands data (a run costs one byte per 255 of its length), plus room for small
+// frames whose headers outweigh their data.
+constexpr uint32_t kMaxLz4Expansion = 255;
+constexpr uint64_t kLz4FrameSlackBytes = 1024;
 constexpr size_t kIndexEntryBytes = 12;     // time (8) and offset (4)
 constexpr size_t kChunkInfoEntryBytes = 8;  // connection id (4) and count (4)
 
@@ -263,6 +267,14 @@ class BagChecker {
         layout.compression != "lz4") {
       Fail(record.offset, "a chunk compressed with '" + MessageExcerpt(layout.compression) +
                               "' (rosbag_storage reads none, bz2 and lz4)");
+    }
+    // An LZ4 match of n bytes costs at least one byte per 255 of its length, so no LZ4 data
+    // expands more than 255-fold: a larger declared size is a lie that would cost its memory.
+    if (layout.compression == "lz4" &&
+        layout.size > uint64_t{kMaxLz4Expansion} * layout.data_size + kLz4FrameSlackBytes) {
+      Fail(record.offset, "an LZ4 chunk of " + std::to_string(layout.data_size) +
+                              " bytes declares " + std::to_string(layout.size) +
+                              " uncompressed, more than LZ4 expands to");
     }
     if (layout.size > kMaxChunkBytes) {
       Fail(record.offset, "a chunk of " + std::to_string(layout.size) + " bytes, more than the " +
