@@ -39,7 +39,8 @@ test-sanitize: deps
 # files (README.md, Robustness), so the HDF5 target runs in fork mode, which records those in
 # findings/ and goes on; a crash still stops it.
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS = event_text_fuzzer frame_list_fuzzer hdf5_io_fuzzer aedat4_fuzzer aedat_legacy_fuzzer
+FUZZ_TARGETS = event_text_fuzzer frame_list_fuzzer hdf5_io_fuzzer aedat4_fuzzer aedat_legacy_fuzzer \
+  rosbag_fuzzer
 FUZZ_DIR = build-fuzz/tests/fuzz
 
 fuzz:

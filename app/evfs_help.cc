@@ -34,8 +34,9 @@ ProgramHelp MakeEvfsHelp() {
        "Simulate the events of a sequence of frames, written as a data folder; optionally with "
        "leak, hot pixels, a photoreceptor bandwidth, a blinking LED, a mains lamp and the "
        "frames' exposure, saturation and noise (all off by default)."},
-      {"convert", "--data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR",
-       "Convert a recording between a data folder, HDF5 and AEDAT 4 (or from AEDAT 2.0/3.1)."},
+      {"convert", "--data=DIR|FILE.h5|FILE.aedat4|FILE.bag --out=FILE.h5|FILE.aedat4|DIR",
+       "Convert a recording between a data folder, HDF5 and AEDAT 4 (or from AEDAT 2.0/3.1 or a "
+       "ROS bag)."},
       {"calibrate", "--data=DIR [--first=I --last=J] --out=MODEL.json",
        "Measure the event model of a recording from its own frames and events (the offset b, "
        "the ON and OFF thresholds, their spread, the background event rate), each with its "
@@ -47,8 +48,9 @@ ProgramHelp MakeEvfsHelp() {
   help.notes =
       "DIR is a folder in the Event Camera Dataset layout (events.txt 't x y p', images.txt\n"
       "'t path', images/, optional exposures.txt 'path t_start t_end'), an .h5 file or an\n"
-      ".aedat4 recording (iniVation DV: events and frames), or an AEDAT 2.0/3.1 file (jAER,\n"
-      "cAER, v2e: DAVIS events and APS frames; read only).\n"
+      ".aedat4 recording (iniVation DV: events and frames), an AEDAT 2.0/3.1 file (jAER,\n"
+      "cAER, v2e: DAVIS events and APS frames; read only), or a ROS 1 .bag (dvs_msgs/EventArray\n"
+      "and sensor_msgs/Image topics, chosen by --events_topic/--frames_topic; read only).\n"
       "I, J, K are 0-based lines of images.txt. Example:\n"
       "  evfs reconstruct --data=../shared/data/slider_depth_70_71 --mode=predict --first=0 "
       "--last=1 \\\n      --truth=1 --out=out/slider\n";
@@ -57,6 +59,8 @@ ProgramHelp MakeEvfsHelp() {
   help.flags = {
       // Which data and which frames.
       {"data", "data", "info reconstruct convert video calibrate"},
+      {"events_topic", "data", "info reconstruct convert video"},
+      {"frames_topic", "data", "info reconstruct convert video"},
       {"frames", "data", "simulate"},
       {"mode", "data", "reconstruct"},
       {"first", "data", "info reconstruct video calibrate"},

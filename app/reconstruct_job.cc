@@ -145,7 +145,7 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   stage("read");
   const auto read_start = Clock::now();
   std::unique_ptr<DataSource> opened;
-  if (given == nullptr) opened = DataSource::Open(request.data_path);
+  if (given == nullptr) opened = DataSource::Open(request.data_path, request.data_options);
   const DataSource* source = given != nullptr ? given : opened.get();
   CheckWholeTextRecording(*source);
   result.width = source->width();

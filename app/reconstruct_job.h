@@ -32,8 +32,9 @@ Mode ParseMode(const std::string& name);
 const char* ModeName(Mode mode);
 
 struct ReconstructRequest {
-  std::string data_path;   // data folder or HDF5 file
-  std::string data_label;  // how summary.json names the data ("": data_path)
+  std::string data_path;           // data folder or HDF5 file
+  std::string data_label;          // how summary.json names the data ("": data_path)
+  DataSourceOptions data_options;  // the topics of a ROS bag
   Mode mode = Mode::kPredict;
   int first = 0;   // images.txt line (0-based) of the first / blurred frame
   int last = -1;   // interpolate: the last frame; predict: the frame whose time ends the window

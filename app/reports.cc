@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/time.h"
 #include "io/aedat_legacy.h"
+#include "io/rosbag.h"
 
 namespace evfs {
 
@@ -22,6 +23,18 @@ void PrintRecording(const DataSource& source, std::FILE* out) {
     std::fprintf(out, "format      AEDAT %s (sensor size from %s)\n",
                  legacy->major_version() == 2 ? "2.0" : "3.1",
                  legacy->sensor_size_source().c_str());
+  }
+  if (const auto* bag = dynamic_cast<const RosbagDataSource*>(&source)) {
+    std::fprintf(out, "format      ROS bag: %s\n", bag->topic_choice().c_str());
+    for (const RosbagTopic& topic : bag->topics()) {
+      std::fprintf(out, "  topic     %s  %s  %lld messages\n", topic.name.c_str(),
+                   topic.datatype.c_str(), static_cast<long long>(topic.messages));
+    }
+    if (!bag->frames_topic().empty()) {
+      std::fprintf(out,
+                   "frame time  the image header stamps; exposure unknown (sensor_msgs/Image "
+                   "holds none: --exposure_s gives one)\n");
+    }
   }
   if (source.has_events()) {
     std::fprintf(out, "events      %lld (%lld ON, %lld OFF)\n",

@@ -234,7 +234,8 @@ std::string PlanText(const std::vector<VideoWindow>& windows, const OutputClock&
 // Serialises reads of the recording (DataSource is not thread-safe) and names bad frames.
 class SharedSource {
  public:
-  explicit SharedSource(const std::string& path) : source_(DataSource::Open(path)) {}
+  SharedSource(const std::string& path, const DataSourceOptions& options)
+      : source_(DataSource::Open(path, options)) {}
 
   const DataSource& unlocked() const { return *source_; }
 
@@ -641,7 +642,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   }
   // Loaded before any input is read: a bad weights file fails in milliseconds.
   const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request.denoise);
-  const SharedSource source(request.data_path);
+  const SharedSource source(request.data_path, request.data_options);
   CheckWholeTextRecording(source.unlocked());
   const DataSource& data = source.unlocked();
 

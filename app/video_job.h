@@ -69,8 +69,9 @@ struct VideoDistribution {
 };
 
 struct VideoRequest {
-  std::string data_path;   // data folder, HDF5 or AEDAT 4 file
-  std::string data_label;  // how summary.json names the data ("": data_path)
+  std::string data_path;           // data folder, HDF5 or AEDAT 4 file
+  std::string data_label;          // how summary.json names the data ("": data_path)
+  DataSourceOptions data_options;  // the topics of a ROS bag
   VideoWindowOptions windows;
   double fps = 0.0;              // output rate; 0: kDefaultUpsampling × the observed frame rate
   int jobs = 0;                  // windows solved at once; 0: every core

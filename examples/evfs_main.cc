@@ -8,7 +8,7 @@
 //   evfs denoise     --in=RECONSTRUCTION_DIR --out=DIR [--denoiser=FILE.onnx]
 //   evfs simulate    --frames=DIR --out=DIR [--threshold_pos=… --threshold_neg=… --seed=…]
 //                    [sensor effects, light sources and frame effects]
-//   evfs convert     --data=DIR|FILE.h5|FILE.aedat4 --out=FILE.h5|FILE.aedat4|DIR
+//   evfs convert     --data=DIR|FILE.h5|FILE.aedat4|FILE.bag --out=FILE.h5|FILE.aedat4|DIR
 //   evfs calibrate   --data=DIR [--first=I --last=J] --out=MODEL.json
 //   evfs demo        --out=DIR
 //
@@ -64,8 +64,12 @@
 // Input and output.
 DEFINE_string(data, "",
               "Data folder (Event Camera Dataset layout), HDF5 event file or AEDAT 4 "
-              "recording (.aedat4, from iniVation DV), or AEDAT 2.0/3.1 file (jAER, cAER, "
-              "v2e).");
+              "recording (.aedat4, from iniVation DV), AEDAT 2.0/3.1 file (jAER, cAER, "
+              "v2e), or ROS 1 bag (.bag: dvs_msgs/EventArray and sensor_msgs/Image).");
+DEFINE_string(events_topic, "",
+              "ROS bag: the dvs_msgs/EventArray topic; empty: the first one in the bag.");
+DEFINE_string(frames_topic, "",
+              "ROS bag: the sensor_msgs/Image topic; empty: the first one in the bag.");
 DEFINE_string(frames, "", "simulate: folder with images.txt ('t path' lines) and the frames.");
 DEFINE_string(out, "",
               "Output folder (reconstruct, simulate, demo) or file (convert to .h5 or .aedat4): "
@@ -368,6 +372,14 @@ OutputOptions OutputFromFlags(const std::string& command, const std::string& inp
   return options;
 }
 
+// --events_topic, --frames_topic: how --data is read.
+DataSourceOptions DataOptionsFromFlags() {
+  DataSourceOptions options;
+  options.events_topic = FLAGS_events_topic;
+  options.frames_topic = FLAGS_frames_topic;
+  return options;
+}
+
 // The binning flags (reconstruct, and info's window).
 BinningOptions BinningFromFlags() {
   BinningOptions binning;
@@ -386,7 +398,7 @@ BinningOptions BinningFromFlags() {
 
 int RunInfo() {
   Require(!FLAGS_data.empty(), "info needs --data=DIR or --data=FILE.h5");
-  const auto source = DataSource::Open(FLAGS_data);
+  const auto source = DataSource::Open(FLAGS_data, DataOptionsFromFlags());
   PrintRecording(*source, stdout);
   if (FLAGS_first >= 0 && source->has_events()) {
     const int last = FLAGS_last >= 0 ? FLAGS_last : FLAGS_first + 1;
@@ -412,7 +424,7 @@ int RunConvert() {
     options.is_own_file = IsAedat4WrittenByEvfs;
   }
   OutputTarget out(options);
-  ConvertRecording(FLAGS_data, out.staging());
+  ConvertRecording(FLAGS_data, out.staging(), DataOptionsFromFlags());
   out.Commit();
   std::printf("wrote %s\n", out.path().c_str());
   return 0;
@@ -541,6 +553,7 @@ int RunCalibrate() {
 ReconstructRequest RequestFromFlags(bool with_mode = true) {
   ReconstructRequest request;
   request.data_path = FLAGS_data;
+  request.data_options = DataOptionsFromFlags();
   if (with_mode) request.mode = ParseMode(FLAGS_mode);
   request.first = FLAGS_first;
   request.last = FLAGS_last;
@@ -692,6 +705,7 @@ int RunVideoCommand(ProgressReporter* progress) {
   const ReconstructRequest reconstruct = RequestFromFlags(/*with_mode=*/false);
   VideoRequest request;
   request.data_path = FLAGS_data;
+  request.data_options = reconstruct.data_options;
   request.windows.first = std::max(FLAGS_first, 0);
   request.windows.last = FLAGS_last;
   request.windows.predict_tail = FLAGS_predict_tail;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <filesystem>
 #include <utility>
 
@@ -9,6 +10,7 @@
 #include "io/aedat4.h"
 #include "io/aedat_legacy.h"
 #include "io/hdf5_io.h"
+#include "io/rosbag.h"
 #include "io/text_folder.h"
 
 namespace evfs {
@@ -23,6 +25,13 @@ DataSource::DataSource(std::string path, int width, int height, std::vector<Fram
 
 DataSource::~DataSource() = default;
 
+void DataSource::CheckFrameIndex(int index) const {
+  if (index < 0 || index >= static_cast<int>(frames_.size())) {
+    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
+                               std::to_string(frames_.size()) + ")");
+  }
+}
+
 bool IsHdf5Path(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
@@ -30,8 +39,21 @@ bool IsHdf5Path(const std::string& path) {
   return extension == ".h5" || extension == ".hdf5";
 }
 
-std::unique_ptr<DataSource> DataSource::Open(const std::string& path) {
+std::unique_ptr<DataSource> DataSource::Open(const std::string& path,
+                                             const DataSourceOptions& options) {
   std::error_code error;
+  if (IsRosbagPath(path) || StartsWithRosbagMagic(path)) {
+    auto bag = std::make_unique<RosbagDataSource>(path, options);
+    // Which topics a bag gives is not obvious from its name: say it when evfs chose.
+    if (options.events_topic.empty() || options.frames_topic.empty()) {
+      std::fprintf(stderr, "evfs: %s: %s\n", path.c_str(), bag->topic_choice().c_str());
+    }
+    return bag;
+  }
+  if (!options.empty()) {
+    throw InvalidArgumentError("--events_topic and --frames_topic apply to ROS bags (.bag), not " +
+                               path);
+  }
   if (std::filesystem::is_directory(path, error)) {
     return std::make_unique<TextFolderDataSource>(path);
   }
@@ -46,14 +68,15 @@ std::unique_ptr<DataSource> DataSource::Open(const std::string& path) {
   }
   if (!std::filesystem::exists(path, error)) {
     throw InputError(InputError::Kind::kMissingFile, path, 0,
-                     "no such data folder, HDF5 or AEDAT 4 file");
+                     "no such data folder, HDF5, AEDAT or ROS bag file");
   }
   throw InputError(InputError::Kind::kMalformed, path, 0,
-                   "expected a data folder, an .h5/.hdf5 or an .aedat4 file");
+                   "expected a data folder, an .h5/.hdf5, an .aedat4 or a .bag file");
 }
 
-void ConvertRecording(const std::string& input, const std::string& output) {
-  const std::unique_ptr<DataSource> source = DataSource::Open(input);
+void ConvertRecording(const std::string& input, const std::string& output,
+                      const DataSourceOptions& options) {
+  const std::unique_ptr<DataSource> source = DataSource::Open(input, options);
   // A recording of frames only stays one in a data folder or an AEDAT 4 file; the HDF5 layout
   // holds events, so there ReadAllEvents refuses it (naming `evfs simulate`).
   const bool with_events = source->has_events() || IsHdf5Path(output);

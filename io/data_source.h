@@ -51,13 +51,26 @@ struct EventSummary {
   }
 };
 
+/// Options of a source that only some formats use (the flags --events_topic, --frames_topic).
+struct DataSourceOptions {
+  /// ROS bags: the dvs_msgs/EventArray topic to read; "": the first one in the bag.
+  std::string events_topic;
+  /// ROS bags: the sensor_msgs/Image topic to read; "": the first one in the bag.
+  std::string frames_topic;
+
+  bool empty() const { return events_topic.empty() && frames_topic.empty(); }
+};
+
 /// A recording opened for reading. Not thread-safe (HDF5 is built serial).
 class DataSource {
  public:
-  /// Opens a data folder (text layout), an .h5/.hdf5 file or an AEDAT 4 file (.aedat4, or any
-  /// file starting with an AEDAT version line; io/aedat4.h). Throws InputError when the path is
-  /// missing, of an unknown kind, or malformed.
-  static std::unique_ptr<DataSource> Open(const std::string& path);
+  /// Opens a data folder (text layout), an .h5/.hdf5 file, an AEDAT file (.aedat4, or any file
+  /// starting with an AEDAT version line; io/aedat4.h, io/aedat_legacy.h) or a ROS 1 bag (.bag,
+  /// or any file starting with "#ROSBAG V"; io/rosbag.h), with the topics `options` names.
+  /// Throws InputError when the path is missing, of an unknown kind, or malformed, and
+  /// InvalidArgumentError when `options` names topics for a recording that is no bag.
+  static std::unique_ptr<DataSource> Open(const std::string& path,
+                                          const DataSourceOptions& options = DataSourceOptions());
 
   virtual ~DataSource();
 
@@ -87,6 +100,8 @@ class DataSource {
 
  protected:
   DataSource(std::string path, int width, int height, std::vector<FrameInfo> frames);
+  /// Throws InvalidArgumentError unless `index` names a frame of frames() (ReadImage's check).
+  void CheckFrameIndex(int index) const;
 
   std::string path_;
   int width_ = 0;
@@ -98,13 +113,15 @@ class DataSource {
 /// True when `path` names an HDF5 file by its extension (.h5 or .hdf5, any case).
 bool IsHdf5Path(const std::string& path);
 
-/// Copies a recording from `input` (folder, HDF5 or AEDAT 4 file) to `output` (an .h5/.hdf5
+/// Copies a recording from `input` (folder, HDF5, AEDAT or ROS bag, opened with `options`) to
+/// `output` (an .h5/.hdf5
 /// path gives HDF5, an .aedat4 path AEDAT 4, anything else a data folder), losslessly: events to
 /// the nanosecond, frames with their pixel values and bit depth, timestamps, exposures and
 /// images.txt paths. AEDAT 4 keeps times to the microsecond and 8-bit frames only (WriteAedat4
 /// rounds the times and refuses finer pixels). A recording of frames only (has_events() false)
 /// stays one in a data folder or an AEDAT 4 file; HDF5 refuses it, as it holds events.
-void ConvertRecording(const std::string& input, const std::string& output);
+void ConvertRecording(const std::string& input, const std::string& output,
+                      const DataSourceOptions& options = DataSourceOptions());
 
 }  // namespace evfs
 

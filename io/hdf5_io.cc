@@ -671,10 +671,7 @@ Hdf5DataSource::~Hdf5DataSource() = default;
 int64_t Hdf5DataSource::num_events() const { return file_->num_events(); }
 
 Image Hdf5DataSource::ReadImage(int index) const {
-  if (index < 0 || index >= static_cast<int>(frames_.size())) {
-    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
-                               std::to_string(frames_.size()) + ")");
-  }
+  CheckFrameIndex(index);
   return file_->ReadImage(index);
 }
 

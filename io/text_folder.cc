@@ -117,10 +117,7 @@ TextFolderDataSource::TextFolderDataSource(const std::string& folder, std::vecto
 TextFolderDataSource::~TextFolderDataSource() = default;
 
 Image TextFolderDataSource::ReadImage(int index) const {
-  if (index < 0 || index >= static_cast<int>(frames_.size())) {
-    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
-                               std::to_string(frames_.size()) + ")");
-  }
+  CheckFrameIndex(index);
   const std::string image_path = (fs::path(path_) / frames_[index].path).string();
   const std::string expected = "the sensor size " + std::to_string(width_) + "x" +
                                std::to_string(height_) + " of the first image";

@@ -326,11 +326,15 @@ py::array VideoArray(Video&& video, const std::string& dtype) {
   return std::move(frames);
 }
 
-py::dict ReadArrays(const std::string& path) {
+py::dict ReadArrays(const std::string& path, const std::string& events_topic,
+                    const std::string& frames_topic) {
+  DataSourceOptions options;
+  options.events_topic = events_topic;
+  options.frames_topic = frames_topic;
   std::unique_ptr<DataSource> source;
   {
     py::gil_scoped_release release;
-    source = DataSource::Open(path);
+    source = DataSource::Open(path, options);
   }
   const std::vector<FrameInfo>& frames = source->frames();
   const int num_frames = static_cast<int>(frames.size());
@@ -563,9 +567,12 @@ PYBIND11_MODULE(evfs, m) {
     }
   });
 
-  m.def("read", &evfs::ReadArrays, py::arg("path"),
-        "Reads a recording: a data folder (Event Camera Dataset layout), an HDF5 file (.h5) or an "
-        "AEDAT 4 file (.aedat4), or an AEDAT 2.0/3.1 file (jAER, cAER, v2e). Returns a dict: "
+  m.def("read", &evfs::ReadArrays, py::arg("path"), py::kw_only(), py::arg("events_topic") = "",
+        py::arg("frames_topic") = "",
+        "Reads a recording: a data folder (Event Camera Dataset layout), an HDF5 file (.h5), an "
+        "AEDAT 4 file (.aedat4), an AEDAT 2.0/3.1 file (jAER, cAER, v2e) or a ROS 1 bag (.bag; "
+        "events_topic, frames_topic: its dvs_msgs/EventArray and sensor_msgs/Image topics, by "
+        "default the first of each). Returns a dict: "
         "'frames' (frames x height x width float64 "
         "intensities in [0, 1]), 'frame_times' (float64 seconds), 'exposures' (frames x 2 float64 "
         "seconds, begin and end; NaN where unknown), 'frame_paths' (list of str), 'events' (dict "

@@ -18,6 +18,11 @@ packages=(
   # AEDAT 4 (io/aedat4/); the python3 modules decode the real samples independently in tests.
   libflatbuffers-dev flatbuffers-compiler liblz4-dev libzstd-dev libtinyxml2-dev
   python3-lz4 python3-zstandard python3-flatbuffers
+  # ROS 1 bags: rosbag_storage reads the container (its bag.h includes pluginlib, which includes
+  # the ROS 2 headers below; io/CMakeLists.txt finds them); python3-rosbag writes the test bags
+  # (tests/io/write_rosbag.py) independently of evfs.
+  librosbag-storage-dev pluginlib-dev libclass-loader-dev librcpputils-dev librcutils-dev
+  libament-index-cpp-dev libroscpp-core-dev libconsole-bridge-dev python3-rosbag python3-pil
   # benchmarks/plot_methods.py: method_benchmark's PSNR-against-time plots.
   python3-matplotlib
   # The Python module (python/) and its pytest suite.

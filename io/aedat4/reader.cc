@@ -528,10 +528,7 @@ int Aedat4DataSource::num_event_packets() const { return file_->num_event_packet
 int64_t Aedat4DataSource::packets_decoded() const { return file_->packets_decoded(); }
 
 Image Aedat4DataSource::ReadImage(int index) const {
-  if (index < 0 || index >= static_cast<int>(frames_.size())) {
-    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
-                               std::to_string(frames_.size()) + ")");
-  }
+  CheckFrameIndex(index);
   return file_->ReadImage(index);
 }
 

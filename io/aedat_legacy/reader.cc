@@ -16,6 +16,7 @@
 #include "io/aedat_legacy/format.h"
 #include "io/aedat_legacy/header.h"
 #include "io/mapped_file.h"
+#include "io/visited_events.h"
 
 namespace evfs {
 namespace aedat_legacy {
@@ -591,32 +592,22 @@ const std::string& AedatLegacyDataSource::sensor_size_source() const {
 int64_t AedatLegacyDataSource::units_decoded() const { return file_->units_decoded(); }
 
 Image AedatLegacyDataSource::ReadImage(int index) const {
-  if (index < 0 || index >= static_cast<int>(frames_.size())) {
-    throw InvalidArgumentError("frame index " + std::to_string(index) + " is outside [0, " +
-                               std::to_string(frames_.size()) + ")");
-  }
+  CheckFrameIndex(index);
   return file_->ReadImage(index);
 }
 
 EventStream AedatLegacyDataSource::ReadEvents(int64_t t_begin_ns, int64_t t_end_ns) const {
-  EventStream events(width_, height_);
-  file_->ForEachEvent(t_begin_ns, t_end_ns, [&](int64_t t_ns, int x, int y, int polarity) {
-    events.push_back(t_ns, static_cast<uint16_t>(x), static_cast<uint16_t>(y),
-                     static_cast<int8_t>(polarity));
-  });
-  return events;
+  return CollectVisitedEvents(
+      width_, height_, [&](auto&& visit) { file_->ForEachEvent(t_begin_ns, t_end_ns, visit); });
 }
 
 EventStream AedatLegacyDataSource::ReadAllEvents() const {
-  return ReadEvents(std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+  return ReadEvents(kAllEventsBeginNs, kAllEventsEndNs);
 }
 
 EventSummary AedatLegacyDataSource::Summarize() const {
-  EventSummary summary;
-  file_->ForEachEvent(
-      std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max(),
-      [&](int64_t t_ns, int x, int y, int polarity) { summary.Add(t_ns, x, y, polarity); });
-  return summary;
+  return SummarizeVisitedEvents(
+      [&](auto&& visit) { file_->ForEachEvent(kAllEventsBeginNs, kAllEventsEndNs, visit); });
 }
 
 }  // namespace evfs

@@ -172,6 +172,28 @@ def test_read_shared_aedat4_against_independent_decoding():
     assert recording["frames"].shape[0] == 0
 
 
+def test_read_ros_bag_as_the_folder(tmp_path):
+    folder = shared_data("slider_depth_70_71")
+    writer = os.path.join(SOURCE_DIR, "tests", "io", "write_rosbag.py")
+    if subprocess.run(["/usr/bin/python3", "-c", "import rosbag"]).returncode != 0:
+        pytest.skip("python3-rosbag is not installed: tests/io/write_rosbag.py cannot write bags")
+    bag = str(tmp_path / "recording.bag")
+    subprocess.run(["/usr/bin/python3", writer, folder, bag, "--compression", "lz4",
+                    "--second_events_topic", "/dvs2/events"], check=True)
+    expected = evfs.read(folder)
+    recording = evfs.read(bag)
+    np.testing.assert_array_equal(recording["frames"], expected["frames"])
+    # The header stamps, not the bag's receive times (the writer makes them 10 ms later).
+    np.testing.assert_array_equal(recording["frame_times"], expected["frame_times"])
+    assert np.isnan(recording["exposures"]).all()
+    for key in ("t", "x", "y", "p"):
+        np.testing.assert_array_equal(recording["events"][key], expected["events"][key])
+    flipped = evfs.read(bag, events_topic="/dvs2/events")
+    np.testing.assert_array_equal(flipped["events"]["p"], -expected["events"]["p"])
+    with pytest.raises(ValueError, match="no such topic"):
+        evfs.read(bag, frames_topic="/nope")
+
+
 @pytest.mark.parametrize("name", ["fuzz_aedat4_misaligned_events.aedat4",
                                   "fuzz_image_extent_wraps_int.h5"])
 def test_read_malformed_file_raises_the_cli_message(name):

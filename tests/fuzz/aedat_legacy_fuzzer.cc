@@ -20,24 +20,6 @@ namespace {
 // The name errors give the input.
 constexpr char kInputName[] = "fuzz/recording.aedat";
 
-void CheckEvents(const AedatLegacyDataSource& source, const EventStream& all) {
-  const EventSummary summary = source.Summarize();
-  Require(summary.count == static_cast<int64_t>(all.size()),
-          "the summary counts other events than the full read");
-  if (all.empty()) return;
-  const size_t last = all.size() - 1;
-  for (size_t i = 0; i <= 2; ++i) {
-    for (size_t j = i; j <= 2; ++j) {
-      const int64_t begin = all.t_ns(i * last / 2);
-      const int64_t end = j == 2 ? After(all.last_t_ns()) : all.t_ns(j * last / 2);
-      for (const int64_t from : {begin, After(begin)}) {
-        Require(source.ReadEvents(from, end) == all.Slice(from, end),
-                "a windowed read differs from slicing the full read");
-      }
-    }
-  }
-}
-
 void FuzzRecording(const uint8_t* data, size_t size) {
   try {
     const auto source =
@@ -51,7 +33,7 @@ void FuzzRecording(const uint8_t* data, size_t size) {
         CheckMessage(error, kInputName);
       }
     }
-    CheckEvents(*source, source->ReadAllEvents());
+    CheckSummaryAndWindows(*source, source->ReadAllEvents());
   } catch (const Error& error) {
     CheckMessage(error, kInputName);
   }

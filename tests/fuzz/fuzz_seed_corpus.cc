@@ -13,12 +13,16 @@
 //                    no frames, as a whole-sensor frame alone is 86 KB (3.1) or 1.4 MB (2.0)
 //   OUT/hdf5_io/     tiny recordings cut from the snippets and converted to HDF5 by
 //                    ConvertRecording, the code behind `evfs convert`
+//   OUT/rosbag/      the same tiny recordings as ROS bags with each compression, 8 events per
+//                    message, written by tests/io/write_rosbag.py (none when python3-rosbag is
+//                    not installed)
 //
 //   fuzz_seed_corpus DATA_DIR OUT
 #include <flatbuffers/flatbuffers.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -182,8 +186,26 @@ void WriteAedatLegacySeeds(const DataSource& source, const fs::path& out_stem) {
   WriteText(out_stem.string() + ".aedat3", v3);
 }
 
+// A tiny recording (an HDF5 seed) as ROS bags, through a data folder and the independent
+// writer; nothing when python3-rosbag is missing.
+void WriteRosbagSeeds(const fs::path& h5_path, const fs::path& out_stem, const fs::path& scratch) {
+  if (std::system("/usr/bin/python3 -c 'import rosbag' >/dev/null 2>&1") != 0) return;
+  fs::remove_all(scratch);
+  ConvertRecording(h5_path.string(), scratch.string());
+  for (const char* compression : {"none", "bz2", "lz4"}) {
+    const std::string command = "/usr/bin/python3 " EVFS_SOURCE_DIR "/tests/io/write_rosbag.py " +
+                                scratch.string() + " " + out_stem.string() + "_" + compression +
+                                ".bag --events_per_message 8 --compression " + compression;
+    if (std::system(command.c_str()) != 0) {
+      throw InputError(InputError::Kind::kUnwritable, out_stem.string(), 0, "cannot write");
+    }
+  }
+  fs::remove_all(scratch);
+}
+
 int Run(const fs::path& data_dir, const fs::path& out) {
-  for (const char* target : {"event_text", "frame_list", "hdf5_io", "aedat4", "aedat_legacy"}) {
+  for (const char* target :
+       {"event_text", "frame_list", "hdf5_io", "aedat4", "aedat_legacy", "rosbag"}) {
     fs::create_directories(out / target);
   }
   std::vector<fs::path> snippets;
@@ -220,6 +242,7 @@ int Run(const fs::path& data_dir, const fs::path& out) {
     WriteAedat4Seeds(out / "hdf5_io" / (name + ".h5"), out / "aedat4" / name);
     WriteAedat4Seeds(out / "hdf5_io" / (name + "_ns.h5"), out / "aedat4" / (name + "_ns"));
     WriteAedatLegacySeeds(*source, out / "aedat_legacy" / name);
+    WriteRosbagSeeds(out / "hdf5_io" / (name + ".h5"), out / "rosbag" / name, scratch);
   }
   for (const char* folder : {"aedat4_dvxplorer_sample", "aedat4_davis346_street"}) {
     const fs::path recording = data_dir / folder / "sample.aedat4";

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "io/data_source.h"
 
 namespace evfs {
 namespace fuzzing {
@@ -80,6 +81,27 @@ inline void Require(bool condition, const char* what) {
   if (!condition) {
     std::fprintf(stderr, "broken promise: %s\n", what);
     std::abort();
+  }
+}
+
+/// Aborts unless the summary of `source` counts the events of `all` (its full read) and windowed
+/// reads between events at the start, the middle and the end, from each or 1 ns after, equal
+/// slicing `all`.
+inline void CheckSummaryAndWindows(const DataSource& source, const EventStream& all) {
+  const EventSummary summary = source.Summarize();
+  Require(summary.count == static_cast<int64_t>(all.size()),
+          "the summary counts other events than the full read");
+  if (all.empty()) return;
+  const size_t last = all.size() - 1;
+  for (size_t i = 0; i <= 2; ++i) {
+    for (size_t j = i; j <= 2; ++j) {
+      const int64_t begin = all.t_ns(i * last / 2);
+      const int64_t end = j == 2 ? After(all.last_t_ns()) : all.t_ns(j * last / 2);
+      for (const int64_t from : {begin, After(begin)}) {
+        Require(source.ReadEvents(from, end) == all.Slice(from, end),
+                "a windowed read differs from slicing the full read");
+      }
+    }
   }
 }
 
