@@ -487,6 +487,7 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   request.binning = settings.request.binning;
   request.method = settings.request.method;
   request.denoise = settings.request.denoise;
+  request.data_options = settings.request.data_options;
   // What --resume compares: everything that decides the frames (not jobs, resume, overwrite).
   request.settings =
       std::string(py::str(ReconstructOptionValues(settings))) +

@@ -95,6 +95,12 @@ Option<Settings> BoolOption(const char* key, Field field) {
           [key, field](py::handle v, Settings* s) { field(*s) = ToBool(key, v); }};
 }
 
+template <typename Settings, typename Field>
+Option<Settings> StringOption(const char* key, Field field) {
+  return {key, [field](const Settings& s) { return py::cast(field(const_cast<Settings&>(s))); },
+          [key, field](py::handle v, Settings* s) { field(*s) = ToString(key, v); }};
+}
+
 template <typename Settings, typename Enum, std::size_t N, typename Field>
 Option<Settings> EnumOption(const char* key, const EnumName<Enum> (&table)[N], Field field) {
   return {key,
@@ -114,7 +120,11 @@ ceres::Solver::Options& Ceres(R& s) { return Rec(s).solver; }
 
 const std::vector<Option<R>>& ReconstructOptionTable() {
   static const std::vector<Option<R>> table = {
-      // Data and output.
+      // Data and output. The topics of a ROS bag (evfs.video; evfs.read takes them itself).
+      StringOption<R>("events_topic",
+                      [](R& s) -> std::string& { return s.request.data_options.events_topic; }),
+      StringOption<R>("frames_topic",
+                      [](R& s) -> std::string& { return s.request.data_options.frames_topic; }),
       DoubleOption<R>("exposure_s", [](R& s) -> double& { return s.request.exposure_s; }),
       DoubleOption<R>("fps", [](R& s) -> double& { return s.request.fps; }),
       {"frame_time",

@@ -320,7 +320,9 @@ EventModelCalibration CalibrateEventModel(const std::vector<Image>& frames,
   if (options.max_fit_pixels > 0 && runs.size() > static_cast<size_t>(options.max_fit_pixels)) {
     const size_t stride = (runs.size() + options.max_fit_pixels - 1) / options.max_fit_pixels;
     size_t kept = 0;
-    for (size_t i = 0; i < runs.size(); i += stride) runs[kept++] = std::move(runs[i]);
+    for (size_t i = 0; i < runs.size(); i += stride, ++kept) {
+      if (kept != i) runs[kept] = std::move(runs[i]);
+    }
     runs.resize(kept);
   }
 
