@@ -11,7 +11,7 @@ one markdown table per binary of the medians of:
   * the stages summary.json times (read, bin, build, solve, write) and, inside the solve, what
     Ceres reports (preprocessor, residual and Jacobian evaluation, linear solver);
   * Ceres iterations and the PSNR of the withheld frame or frames;
-and, with two binaries, the ratios after / before of the pairs' CPU seconds.
+and, with two binaries, the ratios after / before of the pairs' CPU and wall seconds.
 
 The floor of a solve is its evaluations: every Levenberg-Marquardt iteration evaluates the
 residuals and the Jacobian at least once, so "evaluation" (Ceres' residual + Jacobian time) is
@@ -131,12 +131,15 @@ def main():
             share = f"{statistics.median(floor):.0%}" if floor else ""
             print(f"| {name} | " + " | ".join(cells) + f" | {share} |")
     if len(binaries) == 2:
-        print(f"\nafter / before, CPU seconds, median of the {args.runs} pairs\n")
-        print("| job | ratio |\n| --- | --- |")
+        print(f"\nafter / before, median of the {args.runs} pairs\n")
+        print("| job | CPU s | wall s |\n| --- | --- | --- |")
         for name in results[binaries[0]]:
-            pairs = zip(results[binaries[0]][name], results[binaries[1]][name])
-            ratio = statistics.median(a["cpu"] / b["cpu"] for a, b in pairs)
-            print(f"| {name} | x{ratio:.2f} |")
+            pairs = list(zip(results[binaries[0]][name], results[binaries[1]][name]))
+            cells = []
+            for figure in ("cpu", "wall"):
+                ratios = [a[figure] / b[figure] for a, b in pairs if figure in a and figure in b]
+                cells.append(f"x{statistics.median(ratios):.2f}" if ratios else "")
+            print(f"| {name} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":
