@@ -468,8 +468,9 @@ py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle op
 // process; Ctrl-C stops it through RunInterruptibly.
 py::dict VideoFromPath(const std::string& data, const std::string& out, const py::int_& first,
                        const py::int_& last, double fps, const py::int_& jobs,
-                       const py::int_& frame_step, bool predict_tail, bool preview, bool report,
-                       bool resume, bool overwrite, py::handle options) {
+                       const py::int_& frame_step, bool predict_tail, double predict_max_s,
+                       double min_blur_exposure_s, bool blur_from_data, bool skip_bad_frames,
+                       bool preview, bool report, bool resume, bool overwrite, py::handle options) {
   ReconstructSettings settings = DefaultReconstructSettings();
   ApplyReconstructOptions(options, &settings);
   ResolveDenoise(&settings);
@@ -479,6 +480,11 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   request.windows.last = IntArgument(last, "last");
   request.windows.frame_step = IntArgument(frame_step, "frame_step");
   request.windows.predict_tail = predict_tail;
+  request.windows.predict_max_s = predict_max_s;
+  request.windows.min_blur_exposure_s = min_blur_exposure_s;
+  request.windows.blur_from_data = blur_from_data;
+  request.windows.exposure_s = settings.request.exposure_s;
+  request.skip_bad_frames = skip_bad_frames;
   request.fps = fps;
   request.jobs = IntArgument(jobs, "jobs");
   request.preview = preview;
@@ -494,7 +500,11 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
       " first=" + std::to_string(request.windows.first) +
       " last=" + std::to_string(request.windows.last) + " fps=" + std::to_string(fps) +
       " frame_step=" + std::to_string(request.windows.frame_step) +
-      " predict_tail=" + std::to_string(predict_tail) + " preview=" + std::to_string(preview);
+      " predict_tail=" + std::to_string(predict_tail) +
+      " predict_max_s=" + std::to_string(predict_max_s) +
+      " min_blur_exposure_s=" + std::to_string(min_blur_exposure_s) +
+      " blur_from_data=" + std::to_string(blur_from_data) +
+      " skip_bad_frames=" + std::to_string(skip_bad_frames) + " preview=" + std::to_string(preview);
   // A calibration file rewritten in place keeps its path: its bytes decide the model.
   if (!settings.event_model_file.empty()) {
     request.settings +=
@@ -599,15 +609,19 @@ PYBIND11_MODULE(evfs, m) {
         "simulate_defaults()'s keys. Returns the events as a dict like read()'s 'events'.");
   m.def("video", &evfs::VideoFromPath, py::arg("data"), py::arg("out"), py::kw_only(),
         py::arg("first") = 0, py::arg("last") = -1, py::arg("fps") = 0.0, py::arg("jobs") = 0,
-        py::arg("frame_step") = 1, py::arg("predict_tail") = true, py::arg("preview") = false,
-        py::arg("report") = false, py::arg("resume") = false, py::arg("overwrite") = false,
-        py::arg("options") = py::none(),
+        py::arg("frame_step") = 1, py::arg("predict_tail") = true, py::arg("predict_max_s") = 0.0,
+        py::arg("min_blur_exposure_s") = 0.0,
+        py::arg("blur_from_data") = evfs::VideoWindowOptions().blur_from_data,
+        py::arg("skip_bad_frames") = false, py::arg("preview") = false, py::arg("report") = false,
+        py::arg("resume") = false, py::arg("overwrite") = false, py::arg("options") = py::none(),
         "A whole recording (`data`: a path read() accepts) to one high-framerate video in the "
         "folder `out`, as `evfs video` does (without MPI): out/frames/NNNNNN.png at a uniform "
         "`fps` (0: 10x the frame rate), timestamps.txt, summary.json, video.mp4 (report: also "
         "report.html). first/last "
         "select frames (-1: the last), jobs windows run at once (0: every core), frame_step > 1 "
-        "withholds frames and scores them, resume reuses an interrupted run's windows, "
+        "withholds frames and scores them; predict_max_s, min_blur_exposure_s, blur_from_data and "
+        "skip_bad_frames are the command line's --flags of those names (options' exposure_s too); "
+        "resume reuses an interrupted run's windows, "
         "overwrite replaces an earlier evfs video output. options: reconstruct_defaults()'s "
         "keys. Returns a dict: 'path', 'windows', 'frames', 'fps', 'events', 'codec', ... ");
   m.def(

@@ -596,6 +596,28 @@ def test_video_identical_to_cli(demo, tmp_path):
     assert (foreign / "keep.txt").read_text() == "user data"
 
 
+def test_video_takes_the_command_lines_window_flags(demo, tmp_path):
+    """predict_max_s, min_blur_exposure_s, blur_from_data, skip_bad_frames and the options'
+    exposure_s reach the windows as the command line's flags do."""
+    data = str(demo / "data_blur")
+    flags = {"min_blur_exposure_s": 1.0, "blur_from_data": False, "predict_max_s": 0.01,
+             "skip_bad_frames": True}
+    status, _, stderr = run_cli("video", f"--data={data}", f"--out={tmp_path / 'cli'}",
+                                "--fps=400", "--jobs=1", "--exposure_s=0.004",
+                                *[f"--{k}={str(v).lower()}" for k, v in flags.items()])
+    assert status == 0, stderr
+    evfs.video(data, str(tmp_path / "py"), fps=400, jobs=1, options={"exposure_s": 0.004},
+               **flags)
+    cli_frames, cli_times = read_frame_folder(tmp_path / "cli")
+    py_frames, py_times = read_frame_folder(tmp_path / "py")
+    assert py_times == cli_times
+    np.testing.assert_array_equal(py_frames, cli_frames)
+    # The flags change the result: with the defaults the blurred frames are deblurred.
+    evfs.video(data, str(tmp_path / "default"), fps=400, jobs=1)
+    default_frames, _ = read_frame_folder(tmp_path / "default")
+    assert default_frames.shape != py_frames.shape or not np.array_equal(default_frames, py_frames)
+
+
 # ---------------------------------------------------------------------------------------------
 # No array may crash the interpreter: layouts, sizes, counts
 
