@@ -12,11 +12,13 @@
 #include <cstdio>
 #include <cstring>
 #include <iterator>
+#include <new>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "core/error.h"
-#include "io/hdf5_io.h"
+#include "core/input_library.h"
 #include "io/signal_cleanup.h"
 
 namespace evfs {
@@ -31,49 +33,62 @@ bool IsCrashSignal(int signal_number) {
 }
 
 // Where the worker crashed, written by its crash handler into memory it shares with the parent.
-enum CrashPlace : sig_atomic_t {
-  kCrashPlaceUnknown = 0,  // no handler ran: a signal sent from outside, or no shared memory
-  kCrashInLibhdf5 = 1,     // on a thread inside ScopedLibhdf5Read (io/hdf5_io.h)
-  kCrashOutsideLibhdf5 = 2,
+// The libraries are static objects of the program, at the same addresses in the parent and the
+// worker it forked.
+struct CrashPlace {
+  volatile sig_atomic_t recorded = 0;             // 0: no handler ran (a signal sent from outside)
+  const InputLibrary* volatile inside = nullptr;  // the input library the crash happened in
+  const InputLibrary* volatile last = nullptr;    // the input library the worker last ran
 };
 
 // One page shared by the parent and the worker it forks.
 class SharedCrashPlace {
  public:
   SharedCrashPlace() {
-    void* page = mmap(nullptr, sizeof(sig_atomic_t), PROT_READ | PROT_WRITE,
+    void* page = mmap(nullptr, sizeof(CrashPlace), PROT_READ | PROT_WRITE,
                       MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-    if (page != MAP_FAILED) place_ = static_cast<volatile sig_atomic_t*>(page);
+    if (page != MAP_FAILED) place_ = new (page) CrashPlace();
   }
   ~SharedCrashPlace() {
-    if (place_ != nullptr) munmap(const_cast<sig_atomic_t*>(place_), sizeof(sig_atomic_t));
+    if (place_ != nullptr) munmap(place_, sizeof(CrashPlace));
   }
   SharedCrashPlace(const SharedCrashPlace&) = delete;
   SharedCrashPlace& operator=(const SharedCrashPlace&) = delete;
 
-  volatile sig_atomic_t* get() const { return place_; }
+  CrashPlace* get() const { return place_; }
+  /// What the worker's handler recorded; all null when it recorded nothing.
   CrashPlace value() const {
-    return place_ != nullptr ? static_cast<CrashPlace>(*place_) : kCrashPlaceUnknown;
+    CrashPlace copy;
+    if (place_ != nullptr && place_->recorded) {
+      copy.recorded = 1;
+      copy.inside = place_->inside;
+      copy.last = place_->last;
+    }
+    return copy;
   }
 
  private:
-  volatile sig_atomic_t* place_ = nullptr;
+  CrashPlace* place_ = nullptr;
 };
 
-volatile sig_atomic_t* crash_place = nullptr;  // in the worker: the shared page
+CrashPlace* crash_place = nullptr;  // in the worker: the shared page
 
 // Async-signal-safe. A crash signal runs its handler on the thread that crashed, which is what
-// InLibhdf5() asks about.
+// InputLibraryOfThisThread() asks about.
 void RecordCrashPlace(int signal_number) {
-  if (crash_place != nullptr) *crash_place = InLibhdf5() ? kCrashInLibhdf5 : kCrashOutsideLibhdf5;
+  if (crash_place != nullptr) {
+    crash_place->inside = InputLibraryOfThisThread();
+    crash_place->last = LastInputLibrary();
+    crash_place->recorded = 1;
+  }
   // SA_RESETHAND put the default action back and SA_NODEFER lets it act at once: the worker
   // dies of the signal it received.
   raise(signal_number);
 }
 
-// In the worker. The handler runs on a stack of its own: libhdf5 recursing on a corrupt file
+// In the worker. The handler runs on a stack of its own: a library recursing on a corrupt file
 // may have used up the thread's.
-void InstallCrashRecorder(volatile sig_atomic_t* place) {
+void InstallCrashRecorder(CrashPlace* place) {
   if (place == nullptr) return;
   crash_place = place;
   static char alternate_stack[1 << 16];
@@ -211,16 +226,17 @@ int RunInChildProcess(const std::function<int()>& body, const std::string& prefi
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   const int signal_number = WTERMSIG(status);
   if (IsCrashSignal(signal_number)) {
-    // Only libhdf5's own crash, while it read the user's file, is that file's fault.
-    if (!path.empty() && place.value() == kCrashInLibhdf5) {
-      std::fprintf(stderr,
-                   "%s: %s: crashed (%s) reading it; libhdf5 does so on some corrupt HDF5 "
-                   "files\n",
-                   prefix.c_str(), path.c_str(), strsignal(signal_number));
+    // Only an input library's own crash, while it read the user's file, is that file's fault.
+    const CrashPlace crash = place.value();
+    if (!path.empty() && crash.inside != nullptr) {
+      std::fprintf(stderr, "%s: %s: crashed (%s) reading it; %s does so on %s\n", prefix.c_str(),
+                   path.c_str(), strsignal(signal_number), crash.inside->name, crash.inside->fault);
       return kExitUserError;
     }
+    const std::string outside =
+        !path.empty() && crash.last != nullptr ? std::string(" outside ") + crash.last->name : "";
     std::fprintf(stderr, "%s: internal error: crashed (%s)%s%s; please report it\n", prefix.c_str(),
-                 strsignal(signal_number), path.empty() ? "" : " outside libhdf5", removed_note);
+                 strsignal(signal_number), outside.c_str(), removed_note);
     return kExitInternalError;
   }
   std::fprintf(stderr, "%s: stopped by %s%s\n", prefix.c_str(), strsignal(signal_number),

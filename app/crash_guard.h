@@ -1,15 +1,17 @@
 // Running a command in a worker child process, so that neither a crash nor a signal leaves a
-// half-written output behind, and a crash inside libhdf5 becomes a user error.
+// half-written output behind, and a crash inside a library reading the user's file becomes a
+// user error.
 //
 // The parent forwards SIGINT, SIGTERM and SIGHUP to the worker, waits for it, then removes the
 // paths the worker had registered and not finished (io/signal_cleanup.h: the staging folder of
 // an OutputTarget). Only then does it report: a signal ends the parent the same way, after one
 // line; a crash is one line and a non-zero status.
 //
-// libhdf5 1.10 dereferences offsets read from the file without checking them, so some corrupt
-// .h5 files crash it (docs/robustness.md) where no error can be caught: a crash on a thread
-// inside libhdf5 reading the user's file (io/hdf5_io.h, ScopedLibhdf5Read) is reported as that
-// file's fault. Every other crash, and every failed CHECK, is a bug of evfs': an internal error.
+// Some libraries dereference what they read from a file without checking it, so a corrupt file
+// crashes them where no error can be caught (libhdf5 1.10 on some .h5 files: docs/robustness.md).
+// A crash on a thread inside such a library reading the user's file (core/input_library.h,
+// ScopedInputLibraryRead) is reported as that file's fault. Every other crash, and every failed
+// CHECK, is a bug of evfs': an internal error.
 #ifndef EVFS_APP_CRASH_GUARD_H_
 #define EVFS_APP_CRASH_GUARD_H_
 
@@ -41,11 +43,12 @@ ChildProcessEnd ForkAndWait(const std::function<int()>& body, const std::functio
 
 /// Runs `body` in a forked child and returns its return value (the child's exit status), after
 /// removing what the child left registered for cleanup. When the child dies of SIGSEGV,
-/// SIGBUS, SIGFPE, SIGILL or SIGABRT inside libhdf5 (InLibhdf5() on the crashing thread) and
-/// `path` (the HDF5 file read) is not empty, prints "`prefix`: `path`: crashed (<signal>)
-/// reading it; libhdf5 does so on some corrupt HDF5 files" and returns 2 (kExitUserError);
-/// anywhere else "`prefix`: internal error: crashed (<signal>)...; please report it" and
-/// returns 3 (kExitInternalError). Any other signal that ends the child (SIGINT, SIGTERM,
+/// SIGBUS, SIGFPE, SIGILL or SIGABRT inside an input library (InputLibraryOfThisThread() on the
+/// crashing thread) and `path` (the file such a library reads) is not empty, prints "`prefix`:
+/// `path`: crashed (<signal>) reading it; <library> does so on <its fault>", e.g. "libhdf5 does
+/// so on some corrupt HDF5 files", and returns 2 (kExitUserError); anywhere else "`prefix`:
+/// internal error: crashed (<signal>)[ outside <the library last run>]...; please report it"
+/// and returns 3 (kExitInternalError). Any other signal that ends the child (SIGINT, SIGTERM,
 /// SIGHUP, SIGKILL) is reported in one line and raised again in this process, so the caller
 /// dies as the child did. When fork fails, runs `body` here. Call it before any thread is started.
 int RunInChildProcess(const std::function<int()>& body, const std::string& prefix,

@@ -1,11 +1,8 @@
 #include "io/hdf5_io.h"
 
 #include <hdf5.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -43,13 +40,6 @@ constexpr hsize_t kMaxImageSide = 65536;
 // |t| below this many seconds converts to and from int64 nanoseconds without loss.
 constexpr double kMaxSeconds = 9.2e9;
 
-// The thread reading a user's file in libhdf5 now (its kernel thread id), 0 when none: read by
-// InLibhdf5() in a crash signal handler, hence a lock-free atomic.
-std::atomic<pid_t> libhdf5_reader{0};
-static_assert(std::atomic<pid_t>::is_always_lock_free, "read in a signal handler");
-
-pid_t ThreadId() { return static_cast<pid_t>(syscall(SYS_gettid)); }
-
 // While alive, libhdf5 prints no error stack to stderr (evfs reports its own InputError
 // instead); the handler installed before, if any, is restored after, so that other code in the
 // process using libhdf5 keeps its own reporting.
@@ -72,11 +62,11 @@ class ScopedHdf5ErrorsSilenced {
 };
 
 // Around every stretch of libhdf5 calls reading a file the user gave: errors silenced, and a
-// crash counted as the file's (ScopedLibhdf5Read).
+// crash counted as the file's (core/input_library.h).
 class ReadingWithLibhdf5 {
  private:
   ScopedHdf5ErrorsSilenced silenced_;
-  ScopedLibhdf5Read reading_;
+  ScopedInputLibraryRead reading_{kLibhdf5};
 };
 
 // Owns one HDF5 identifier and closes it with the matching H5?close.
@@ -257,14 +247,7 @@ void ReadSlab(const H5Context& h5, hid_t dataset, const std::string& name, hid_t
 
 }  // namespace
 
-ScopedLibhdf5Read::ScopedLibhdf5Read() : previous_(libhdf5_reader.exchange(ThreadId())) {}
-
-ScopedLibhdf5Read::~ScopedLibhdf5Read() { libhdf5_reader.store(previous_); }
-
-bool InLibhdf5() {
-  const pid_t reader = libhdf5_reader.load();
-  return reader != 0 && reader == ThreadId();
-}
+const InputLibrary kLibhdf5 = {"libhdf5", "some corrupt HDF5 files"};
 
 // ---------------------------------------------------------------------------------------------
 

@@ -12,13 +12,12 @@
 #ifndef EVFS_IO_HDF5_IO_H_
 #define EVFS_IO_HDF5_IO_H_
 
-#include <sys/types.h>
-
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/input_library.h"
 #include "io/data_source.h"
 
 namespace evfs {
@@ -63,25 +62,11 @@ void WriteHdf5(const std::string& path, const EventStream& events,
 /// "evfs"): the only kind of file `evfs convert --overwrite` replaces.
 bool IsHdf5WrittenByEvfs(const std::string& path);
 
-/// Marks, for its lifetime, the calling thread as running libhdf5 on a file the user gave.
-/// libhdf5 1.10 crashes on some corrupt files (docs/robustness.md); a crash signal raised
-/// while the crashing thread is marked is the file's fault, anywhere else evfs' own
-/// (app/crash_guard.h). Every stretch of libhdf5 calls that reads a file runs inside one;
-/// writing does not (a crash there is not the input's doing). Nests.
-class ScopedLibhdf5Read {
- public:
-  ScopedLibhdf5Read();
-  ~ScopedLibhdf5Read();
-  ScopedLibhdf5Read(const ScopedLibhdf5Read&) = delete;
-  ScopedLibhdf5Read& operator=(const ScopedLibhdf5Read&) = delete;
-
- private:
-  pid_t previous_;  // the thread marked before, restored on destruction
-};
-
-/// True while the calling thread is inside a ScopedLibhdf5Read. Async-signal-safe: meant for
-/// a crash signal handler, which runs on the thread that crashed.
-bool InLibhdf5();
+/// libhdf5 as the library reading a user's file (core/input_library.h): libhdf5 1.10 crashes on
+/// some corrupt files (docs/robustness.md). Every stretch of libhdf5 calls that reads a file
+/// runs inside a ScopedInputLibraryRead of it; writing does not (a crash there is not the
+/// input's doing).
+extern const InputLibrary kLibhdf5;
 
 }  // namespace evfs
 

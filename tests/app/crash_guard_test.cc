@@ -36,7 +36,7 @@ TEST(RunInChildProcess, ACrashInsideLibhdf5IsTheFilesFault) {
   ::testing::internal::CaptureStderr();
   const int status = RunInChildProcess(
       [] {
-        const ScopedLibhdf5Read reading;
+        const ScopedInputLibraryRead reading(kLibhdf5);
         std::raise(SIGILL);
         return 0;
       },
@@ -61,20 +61,51 @@ TEST(RunInChildProcess, ACrashOutsideLibhdf5IsAnInternalErrorEvenReadingHdf5) {
       "evfs test: internal error: crashed (Illegal instruction) outside libhdf5; please report "
       "it\n";
   EXPECT_EQ(crash_of([] {
+              { const ScopedInputLibraryRead reading(kLibhdf5); }
               std::raise(SIGILL);
               return 0;
             }),
             expected);
   EXPECT_EQ(crash_of([] {
-              const ScopedLibhdf5Read reading;
+              const ScopedInputLibraryRead reading(kLibhdf5);
               std::thread([] { std::raise(SIGILL); }).join();
               return 0;
             }),
             expected);
 }
 
+// The runtime names whichever input library a reader marked: it knows none of them.
+TEST(RunInChildProcess, ACrashInsideAnyInputLibraryIsTheFilesFaultInItsWords) {
+  static const InputLibrary kDecoder = {"libdecoder", "some truncated test files"};
+  ::testing::internal::CaptureStderr();
+  int status = RunInChildProcess(
+      [] {
+        const ScopedInputLibraryRead reading(kDecoder);
+        std::raise(SIGILL);
+        return 0;
+      },
+      "evfs test", "file.bin");
+  EXPECT_EQ(status, 2);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(),
+            "evfs test: file.bin: crashed (Illegal instruction) reading it; libdecoder does so on "
+            "some truncated test files\n");
+  // Without a file to blame, the same crash is evfs' own.
+  ::testing::internal::CaptureStderr();
+  status = RunInChildProcess(
+      [] {
+        const ScopedInputLibraryRead reading(kDecoder);
+        std::raise(SIGILL);
+        return 0;
+      },
+      "evfs test", "");
+  EXPECT_EQ(status, 3);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(),
+            "evfs test: internal error: crashed (Illegal instruction); please report it\n");
+}
+
 // The two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation
-// fault (tests/examples/data): the crash happens inside ScopedLibhdf5Read, so it is the file's.
+// fault (tests/examples/data): the crash happens inside libhdf5's ScopedInputLibraryRead, so it
+// is the file's.
 // Whether libhdf5 crashes on one of them depends on the process around it (the attribute file
 // crashed it while OpenCV's imgcodecs, and through it GDAL, were linked in); where it reads the
 // file instead, evfs must refuse the file cleanly. At least one file must crash, or the test

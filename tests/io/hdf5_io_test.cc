@@ -251,21 +251,9 @@ TEST(Hdf5IoTest, Hdf5ErrorPrintingIsSilencedOnlyWhileEvfsCallsLibhdf5) {
   H5Eset_auto2(H5E_DEFAULT, saved, saved_data);
 }
 
-TEST(Hdf5IoTest, ScopedLibhdf5ReadMarksTheCallingThreadOnly) {
-  EXPECT_FALSE(InLibhdf5());
-  {
-    const ScopedLibhdf5Read reading;
-    EXPECT_TRUE(InLibhdf5());
-    {
-      const ScopedLibhdf5Read nested;
-      EXPECT_TRUE(InLibhdf5());
-    }
-    EXPECT_TRUE(InLibhdf5());
-    bool other_thread_marked = true;
-    std::thread([&] { other_thread_marked = InLibhdf5(); }).join();
-    EXPECT_FALSE(other_thread_marked);
-  }
-  EXPECT_FALSE(InLibhdf5());
+// Reading marks the thread as inside libhdf5 only while it is (core/input_library.h).
+TEST(Hdf5IoTest, ReadingMarksLibhdf5OnlyWhileItRuns) {
+  EXPECT_EQ(InputLibraryOfThisThread(), nullptr);
   // Reading leaves no mark behind, on success or failure.
   const std::string dir = test::ScratchDir("h5_marks");
   const Recording recording = MakeRecording(3, 1000);
@@ -273,11 +261,12 @@ TEST(Hdf5IoTest, ScopedLibhdf5ReadMarksTheCallingThreadOnly) {
   {
     const Hdf5DataSource source(dir + "/good.h5");
     EXPECT_EQ(source.ReadAllEvents().size(), recording.events.size());
-    EXPECT_FALSE(InLibhdf5());
+    EXPECT_EQ(InputLibraryOfThisThread(), nullptr);
+    EXPECT_EQ(LastInputLibrary(), &kLibhdf5);
   }
   test::WriteFile(dir + "/garbage.h5", std::string(4096, 'x'));
   EXPECT_THROW(Hdf5DataSource source(dir + "/garbage.h5"), InputError);
-  EXPECT_FALSE(InLibhdf5());
+  EXPECT_EQ(InputLibraryOfThisThread(), nullptr);
 }
 
 // A folder (or FIFO) named like an HDF5 file exists: saying it does not would mislead.
