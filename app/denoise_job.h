@@ -35,7 +35,7 @@ std::string ShippedDenoiserWeights();
 
 /// What `--denoise=auto` does with the shipped weights: none. The shipped network learned from
 /// simulated events only; on real recordings it widens edges and lowers SSIM against the
-/// reconstruction alone (BENCHMARKS.md, "Real windows"), and a default must not lose on real
+/// reconstruction alone (BENCHMARKS.md, "Real recordings"), and a default must not lose on real
 /// data. `--denoise=once` still applies it.
 inline constexpr DenoiseMode kShippedWeightsDenoiseMode = DenoiseMode::kNone;
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The slow frames of the whole clips (issue 16; BENCHMARKS.md "Defaults of issue 16").
+"""The slow frames of the whole clips (BENCHMARKS.md, "`evfs video` on whole clips").
 
 Reads the summary.json files that benchmarks/whole_clips.sh leaves in its scratch folder
 (SCRATCH/out_CLIP from the default method, SCRATCH/integrate_CLIP from --solver=integrate) and

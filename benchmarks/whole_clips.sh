@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole clips, "skip 3" (docs/guide.md, BENCHMARKS.md "Whole clips"): events
+# Whole clips, "skip 3" (docs/guide.md, BENCHMARKS.md "`evfs video` on whole clips"): events
 # simulated with `evfs simulate`'s defaults, every 4th frame observed, every withheld frame
 # scored, by `evfs video` with the default method and denoiser, with the denoiser off
 # (`--denoise=none`: the model-based reconstruction alone) and with event integration.
