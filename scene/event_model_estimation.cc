@@ -45,24 +45,40 @@ EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams
   EventModelEstimate estimate;
 
   // The first and last sharp frames, if they are distinct, bracket the events between them:
-  // the change of g per net event there is what one event stands for, measured directly.
-  const FrameObservation* first = nullptr;
-  const FrameObservation* last = nullptr;
-  for (const FrameObservation& frame : scene.frames) {
-    if (frame.latent_first != frame.latent_last) continue;
-    if (!first || frame.latent_first < first->latent_first) first = &frame;
-    if (!last || frame.latent_first > last->latent_first) last = &frame;
+  // the change of g per net event there is what one event stands for, measured directly. Without
+  // two sharp frames, the first and last blurred ones stand at the middle of their exposures: a
+  // frame averaged over its exposure is close to the scene at its middle, and the median over
+  // the pixels reads through what the averaging smooths at moving edges.
+  struct Anchor {
+    const FrameObservation* frame = nullptr;
+    int latent = 0;
+  };
+  const auto bracket = [&scene](bool sharp_only, Anchor* first, Anchor* last) {
+    for (const FrameObservation& frame : scene.frames) {
+      const bool sharp = frame.latent_first == frame.latent_last;
+      if (sharp_only && !sharp) continue;
+      const int latent = (frame.latent_first + frame.latent_last) / 2;
+      if (!first->frame || latent < first->latent) *first = {&frame, latent};
+      if (!last->frame || latent > last->latent) *last = {&frame, latent};
+    }
+    return first->frame && last->frame && first->latent < last->latent;
+  };
+  Anchor first, last;
+  bool blurred_frames = false;
+  if (!bracket(true, &first, &last)) {
+    first = last = Anchor();
+    blurred_frames = bracket(false, &first, &last);
   }
   int pixels_used = 0;
   double change = 0.0;
   double change_off = 0.0;  // measured per polarity: Δg of an OFF event (change: of an ON one)
-  if (first && last && first->latent_first < last->latent_first) {
-    const std::vector<double> net = NetEventCount(scene, first->latent_first, last->latent_first);
+  if (first.frame && last.frame && first.latent < last.latent) {
+    const std::vector<double> net = NetEventCount(scene, first.latent, last.latent);
     std::vector<double> per_on_event, per_off_event;
     for (size_t p = 0; p < net.size(); ++p) {
       if (net[p] == 0.0) continue;
-      const double frame_change = IntensityTransform(last->image.data()[p], model) -
-                                  IntensityTransform(first->image.data()[p], model);
+      const double frame_change = IntensityTransform(last.frame->image.data()[p], model) -
+                                  IntensityTransform(first.frame->image.data()[p], model);
       if (frame_change * net[p] <= 0.0) continue;  // frames and events disagree: noise, occlusion
       (net[p] > 0.0 ? per_on_event : per_off_event).push_back(frame_change / net[p]);
     }
@@ -92,15 +108,16 @@ EventModelEstimate EstimateEventModel(const Scene& scene, const EventModelParams
   if (change_off > 0.0) {
     estimate.off_alpha_ratio = change / change_off;
     std::snprintf(line, sizeof(line),
-                  "change per event ON %.4f, OFF %.4f (measured between the frames at %d "
+                  "change per event ON %.4f, OFF %.4f (measured between the %sframes at %d "
                   "pixels), alpha %.2f, OFF %.2f",
-                  change, change_off, pixels_used, estimate.alpha,
+                  change, change_off, blurred_frames ? "blurred " : "", pixels_used, estimate.alpha,
                   estimate.alpha * estimate.off_alpha_ratio);
   } else if (estimate.estimated_from_frames) {
     std::snprintf(line, sizeof(line),
-                  "change per event %.4f (measured between the frames at %d pixels), "
+                  "change per event %.4f (measured between the %sframes at %d pixels), "
                   "alpha %.2f",
-                  estimate.change_per_event, pixels_used, estimate.alpha);
+                  estimate.change_per_event, blurred_frames ? "blurred " : "", pixels_used,
+                  estimate.alpha);
   } else {
     std::snprintf(line, sizeof(line),
                   "change per event %.4f (assumed: no two sharp frames to measure it), "

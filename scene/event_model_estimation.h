@@ -3,10 +3,12 @@
 // α decides the quality more than any solver choice: tanh(α·Δg) must be able to express the
 // change Δg one event stands for. α is set to `alpha_times_change / Δg`. When the scene has two
 // sharp frames, Δg is measured: the median over pixels of the change of g between the frames
-// divided by the net event count between them. Otherwise an assumed Δg is used: a typical
-// DAVIS contrast threshold for the log model, and for the linear model the change measured this
-// way on the shared DAVIS snippets (slider_depth 0.098, shapes_rotation 0.087). I·C with I the
-// local intensity is not used: DAVIS frames and events see brightness through different
+// divided by the net event count between them. Without two sharp frames but with two blurred
+// ones, it is measured the same way between them, each at the middle of its exposure (a frame
+// averaged over its exposure is close to the scene at that moment). Otherwise an assumed Δg is
+// used: a typical DAVIS contrast threshold for the log model, and for the linear model the change
+// measured this way on the shared DAVIS snippets (slider_depth 0.098, shapes_rotation 0.087). I·C
+// with I the local intensity is not used: DAVIS frames and events see brightness through different
 // responses, and it was 3× off on both snippets.
 #ifndef EVFS_SCENE_EVENT_MODEL_ESTIMATION_H_
 #define EVFS_SCENE_EVENT_MODEL_ESTIMATION_H_

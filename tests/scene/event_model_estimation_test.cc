@@ -77,5 +77,28 @@ TEST(EventModelEstimation, FallsBackToTheAssumedChangeWithOneFrame) {
   EXPECT_NE(log.description.find("assumed"), std::string::npos);
 }
 
+// Two blurred frames and no sharp one (a video of long exposures): each stands at the middle of
+// its exposure, and the change between them per net event still measures the threshold. One
+// blurred frame alone cannot tell, and the assumed change is used.
+TEST(EventModelEstimation, MeasuresTheThresholdBetweenTwoBlurredFrames) {
+  const test::SyntheticRecording recording(48, 40, 0.04);
+  const TimedFrame first = recording.Blurred(0, 6), last = recording.Blurred(28, 34);
+  const Scene scene = MakeScene({first, last}, recording.events, recording.rendered.timestamp_ns(0),
+                                recording.rendered.timestamp_ns(34) + 1, BinningOptions());
+  EventModelParams log_model;
+  log_model.model = EventModel::kLog;
+  log_model.log_offset = SimulatorOptions().log_eps;
+  EventModelEstimationOptions options;
+  options.per_polarity = false;
+  const EventModelEstimate estimate = EstimateEventModel(scene, log_model, options);
+  ASSERT_TRUE(estimate.estimated_from_frames) << estimate.description;
+  EXPECT_NEAR(estimate.change_per_event, SimulatorOptions().contrast_threshold_pos,
+              2.0 * kThresholdTolerance);
+  EXPECT_NE(estimate.description.find("blurred frames"), std::string::npos) << estimate.description;
+
+  const Scene deblur = MakeDeblurScene(first, recording.events, BinningOptions());
+  EXPECT_FALSE(EstimateEventModel(deblur, log_model, options).estimated_from_frames);
+}
+
 }  // namespace
 }  // namespace evfs
