@@ -422,8 +422,9 @@ std::string FlagValue(const char* name) {
   return value;
 }
 
-// evfs' help (app/evfs_help.h), its own flags being those defined in this file: gflags records
-// the __FILE__ of each DEFINE_, so that renaming the file changes nothing.
+// evfs' help (app/evfs_help.h), its own flags being those registered with this file's name
+// (RegisterEvfsFlags in main): a flag defined here outside the option table has no row, and the
+// help says so.
 const ProgramHelp& MainHelp() {
   static const ProgramHelp help = [] {
     ProgramHelp main_help = EvfsHelp();
