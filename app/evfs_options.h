@@ -85,6 +85,13 @@ const std::vector<std::string>& EvfsOptionGroups();
 /// The option named `name`, or nullptr.
 const OptionDefinition* FindEvfsOption(const std::string& name);
 
+/// The default of option `name`, of its type T (int32_t, double, ...): the Python functions'
+/// arguments that are flags of the command line take it as theirs.
+template <typename T>
+T OptionDefault(const std::string& name) {
+  return std::get<T>(FindEvfsOption(name)->default_value);
+}
+
 /// The help rows of the options (app/command_line_help.h), in table order.
 std::vector<FlagHelp> EvfsFlagHelp();
 

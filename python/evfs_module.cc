@@ -591,12 +591,20 @@ PYBIND11_MODULE(evfs, m) {
         "float32 or float64 in [0, 1], float64 seconds), as `evfs simulate` does. options: "
         "simulate_defaults()'s keys. Returns the events as a dict like read()'s 'events'.");
   m.def("video", &evfs::VideoFromPath, py::arg("data"), py::arg("out"), py::kw_only(),
-        py::arg("first") = 0, py::arg("last") = -1, py::arg("fps") = 0.0, py::arg("jobs") = 0,
-        py::arg("frame_step") = 1, py::arg("predict_tail") = true, py::arg("predict_max_s") = 0.0,
-        py::arg("min_blur_exposure_s") = 0.0,
-        py::arg("blur_from_data") = evfs::VideoWindowOptions().blur_from_data,
-        py::arg("skip_bad_frames") = false, py::arg("preview") = false, py::arg("report") = false,
-        py::arg("resume") = false, py::arg("overwrite") = false, py::arg("options") = py::none(),
+        py::arg("first") = 0, py::arg("last") = evfs::OptionDefault<int32_t>("last"),
+        py::arg("fps") = evfs::OptionDefault<double>("fps"),
+        py::arg("jobs") = evfs::OptionDefault<int32_t>("jobs"),
+        py::arg("frame_step") = evfs::OptionDefault<int32_t>("frame_step"),
+        py::arg("predict_tail") = evfs::OptionDefault<bool>("predict_tail"),
+        py::arg("predict_max_s") = evfs::OptionDefault<double>("predict_max_s"),
+        py::arg("min_blur_exposure_s") = evfs::OptionDefault<double>("min_blur_exposure_s"),
+        py::arg("blur_from_data") = evfs::OptionDefault<bool>("blur_from_data"),
+        py::arg("skip_bad_frames") = evfs::OptionDefault<bool>("skip_bad_frames"),
+        py::arg("preview") = evfs::OptionDefault<bool>("preview"),
+        py::arg("report") = evfs::OptionDefault<bool>("report"),
+        py::arg("resume") = evfs::OptionDefault<bool>("resume"),
+        py::arg("overwrite") = evfs::OptionDefault<bool>("overwrite"),
+        py::arg("options") = py::none(),
         "A whole recording (`data`: a path read() accepts) to one high-framerate video in the "
         "folder `out`, as `evfs video` does (without MPI): out/frames/NNNNNN.png at a uniform "
         "`fps` (0: 10x the frame rate), timestamps.txt, summary.json, video.mp4 (report: also "
