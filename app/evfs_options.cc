@@ -31,21 +31,25 @@ OptionValue Uint64(uint64_t value) { return value; }
 OptionValue Double(double value) { return value; }
 OptionValue Text(const std::string& value) { return value; }
 
-// The field of EvfsSettings named `path`, set to the option's value of the field's own type.
-#define EVFS_OPTION_FIELD(path) \
-#path, [](const OptionValue& value, const std::string&, EvfsSettings* settings) {              \
+// The bindings of the table's rows: the field's path as text (for the table's readers and
+// tests/app/evfs_options_test.cc) and a setter of that field, from one mention of the path.
+// clang-format off
+// The field of EvfsSettings at `path`, set to the option's value (of the field's own type).
+#define EVFS_OPTION_FIELD(path)                                                                  \
+  #path, [](const OptionValue& value, const std::string&, EvfsSettings* settings) {              \
     settings->path = std::get<std::remove_reference_t<decltype(settings->path)>>(value);         \
   }
-// The field `path` set to `parse` of the option's text.
-#define EVFS_OPTION_PARSED(path, parse)                   \
-#path, [](const OptionValue& value, const std::string&, \
-            EvfsSettings* settings) { settings->path = parse(std::get<std::string>(value)); }
-// The enum field `path` set from one of the names of `table` (core/enum_names.h).
-#define EVFS_OPTION_NAMED(path, table)                      \
-#path,                                                    \
-      [](const OptionValue& value, const std::string& flag, \
-         EvfsSettings*                                      \
-             settings) { settings->path = ParseName(table, std::get<std::string>(value), flag); }
+// The field at `path` set to `parse` of the option's text.
+#define EVFS_OPTION_PARSED(path, parse)                                                          \
+  #path, [](const OptionValue& value, const std::string&, EvfsSettings* settings) {              \
+    settings->path = parse(std::get<std::string>(value));                                        \
+  }
+// The enum field at `path` set from one of the names of `table` (core/enum_names.h).
+#define EVFS_OPTION_NAMED(path, table)                                                           \
+  #path, [](const OptionValue& value, const std::string& flag, EvfsSettings* settings) {         \
+    settings->path = ParseName(table, std::get<std::string>(value), flag);                       \
+  }
+// clang-format on
 
 // An option that sets one field in its own way, named by `field` for the table's readers.
 std::pair<std::string, OptionSetter> Custom(const std::string& field, OptionSetter set) {
