@@ -475,11 +475,16 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   // settings for resume to compare, as `evfs video` makes.
   OptionValues values;
   ApplyPythonOptions(options, kReconstructKey, &values);
+  const int first_frame = IntArgument(first, "first");
+  const int last_frame = IntArgument(last, "last");
+  const int step = IntArgument(frame_step, "frame_step");
+  const int windows_at_once = IntArgument(jobs, "jobs");
   values.Set("data", data);
-  values.Set("last", IntArgument(last, "last"));
+  values.Set("first", first_frame);
+  values.Set("last", last_frame);
   values.Set("fps", fps);
-  values.Set("jobs", IntArgument(jobs, "jobs"));
-  values.Set("frame_step", IntArgument(frame_step, "frame_step"));
+  values.Set("jobs", windows_at_once);
+  values.Set("frame_step", step);
   values.Set("predict_tail", predict_tail);
   values.Set("predict_max_s", predict_max_s);
   values.Set("min_blur_exposure_s", min_blur_exposure_s);
@@ -488,8 +493,6 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
   values.Set("preview", preview);
   values.Set("report", report);
   values.Set("resume", resume);
-  const int first_frame = IntArgument(first, "first");
-  values.Set("first", first_frame);
   VideoRequest request = VideoRequestFromOptions(values);
   // The command line reads --first=-1 as 0; Python's first has no such value.
   request.windows.first = first_frame;
