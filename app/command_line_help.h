@@ -5,9 +5,9 @@
 //   evfs --help              the commands, then every flag of the table, group by group
 //   evfs reconstruct --help  that command's synopsis, then only the flags it reads
 //
-// A flag's type, default and description come from gflags (its DEFINE_ line stays the one
-// place they are written); the tables say only where it goes. A new flag gets one FlagHelp row,
-// a new command one CommandHelp row.
+// A flag's type, default and description come from gflags (evfs registers its flags from its
+// option table, app/evfs_options.h, which also makes its FlagHelp rows); the tables say only
+// where it goes. A new command gets one CommandHelp row.
 #ifndef EVFS_APP_COMMAND_LINE_HELP_H_
 #define EVFS_APP_COMMAND_LINE_HELP_H_
 
@@ -43,7 +43,8 @@ struct ProgramHelp {
   /// Shown after the commands of the overview (what the arguments mean, an example).
   std::string notes;
   /// Where the program's own flags are defined (the end of gflags' file name: the __FILE__ of
-  /// the DEFINE_ lines): those without a row are shown under "other" rather than left out.
+  /// the program's flags were registered with): those without a row are shown under "other"
+  /// rather than left out.
   std::string flags_file;
 };
 

@@ -1,5 +1,6 @@
 #include "app/evfs_help.h"
 
+#include "app/evfs_options.h"
 #include "core/version.h"
 
 namespace evfs {
@@ -54,123 +55,8 @@ ProgramHelp MakeEvfsHelp() {
       "I, J, K are 0-based lines of images.txt. Example:\n"
       "  evfs reconstruct --data=../shared/data/slider_depth_70_71 --mode=predict --first=0 "
       "--last=1 \\\n      --truth=1 --out=out/slider\n";
-  help.groups = {"data",   "output",   "method",    "binning", "model",
-                 "solver", "denoiser", "simulator", "progress"};
-  help.flags = {
-      // Which data and which frames.
-      {"data", "data", "info reconstruct convert video calibrate"},
-      {"events_topic", "data", "info reconstruct convert video"},
-      {"frames_topic", "data", "info reconstruct convert video"},
-      {"frames", "data", "simulate"},
-      {"mode", "data", "reconstruct"},
-      {"first", "data", "info reconstruct video calibrate"},
-      {"last", "data", "info reconstruct video calibrate"},
-      {"truth", "data", "reconstruct"},
-      {"exposure_s", "data", "reconstruct video simulate"},
-      {"frame_time", "data", "reconstruct"},
-      // What is written.
-      {"out", "output", "reconstruct denoise simulate convert demo video calibrate"},
-      {"overwrite", "output", "reconstruct denoise simulate convert demo video calibrate"},
-      {"fps", "output", "reconstruct video"},
-      // The method and its own settings.
-      {"solver", "method", "reconstruct video"},
-      {"init", "method", "reconstruct video"},
-      {"checkpoints", "method", "reconstruct"},
-      {"adam_iterations", "method", "reconstruct video"},
-      {"adam_learning_rate", "method", "reconstruct video"},
-      {"contrast_threshold", "method", "reconstruct video"},
-      {"blur_sigma_px", "method", "reconstruct video"},
-      {"cf_cutoff_rad_per_s", "method", "reconstruct video"},
-      // Events into event frames (info shows the binning a reconstruction would get).
-      {"binning", "binning", "info reconstruct video"},
-      {"max_latent_frames", "binning", "info reconstruct video"},
-      {"min_latent_steps", "binning", "info reconstruct video"},
-      {"max_latent_voxels", "binning", "info reconstruct video"},
-      {"hot_pixel_factor", "binning", "info reconstruct video"},
-      {"saturation_level", "binning", "info reconstruct video calibrate"},
-      {"leave_out_saturated", "binning", "info reconstruct video"},
-      {"flicker_min_reversals", "binning", "info reconstruct video"},
-      {"noise_filter_ms", "binning", "info reconstruct video"},
-      {"stacked_frames", "binning", "info reconstruct video"},
-      // The objective and the unknowns.
-      {"frame_weight", "model", "reconstruct video"},
-      {"event_weight", "model", "reconstruct video"},
-      {"spatial_tv_weight", "model", "reconstruct video"},
-      {"temporal_tv_weight", "model", "reconstruct video"},
-      {"alpha", "model", "reconstruct video"},
-      {"event_model", "model", "reconstruct video"},
-      {"event_saturation", "model", "reconstruct video"},
-      {"per_polarity_alpha", "model", "reconstruct video"},
-      {"log_offset", "model", "reconstruct video"},
-      {"spatial_tv", "model", "reconstruct video"},
-      {"shared_structure_tv", "model", "reconstruct video"},
-      {"smoothing_scale", "model", "reconstruct video"},
-      {"smoothing_continuation", "model", "reconstruct video"},
-      {"bounds", "model", "reconstruct video"},
-      {"activity_radius_px", "model", "reconstruct video"},
-      {"merge_quiet_steps", "model", "reconstruct video"},
-      {"unfired_pixel_changes", "model", "reconstruct video"},
-      {"split_independent_parts", "model", "reconstruct video"},
-      {"max_problem_mb", "model", "reconstruct video"},
-      {"quiet_blend_fraction", "model", "reconstruct video"},
-      {"step_ramp_px", "model", "reconstruct video"},
-      {"meet_sharp_frames", "model", "reconstruct video"},
-      // Ceres.
-      {"linear_solver", "solver", "reconstruct video"},
-      {"preconditioner", "solver", "reconstruct video"},
-      {"eta", "solver", "reconstruct video"},
-      {"max_iterations", "solver", "reconstruct video"},
-      {"max_linear_iterations", "solver", "reconstruct video"},
-      {"max_time_s", "solver", "reconstruct video"},
-      {"bounds_line_search_iterations", "solver", "reconstruct video"},
-      {"function_tolerance", "solver", "reconstruct video"},
-      {"threads", "solver", "reconstruct video"},
-      // The residual denoiser.
-      {"in", "denoiser", "denoise"},
-      {"denoise", "denoiser", "reconstruct video"},
-      {"denoiser", "denoiser", "reconstruct denoise video"},
-      {"denoise_consistency", "denoiser", "reconstruct video"},
-      // evfs video's own.
-      {"jobs", "solver", "video"},
-      {"resume", "output", "video"},
-      {"preview", "output", "video"},
-      {"report", "output", "video"},
-      {"predict_tail", "data", "video"},
-      {"predict_max_s", "data", "video"},
-      {"min_blur_exposure_s", "data", "video"},
-      {"blur_from_data", "data", "video"},
-      {"frame_step", "data", "video"},
-      {"skip_bad_frames", "data", "video"},
-      {"allow_outside_paths", "data", "info reconstruct convert video simulate calibrate"},
-      // The event simulator.
-      {"threshold_pos", "simulator", "simulate"},
-      {"threshold_neg", "simulator", "simulate"},
-      {"threshold_sigma", "simulator", "simulate"},
-      {"log_eps", "simulator", "simulate"},
-      {"refractory_s", "simulator", "simulate"},
-      {"noise_rate_hz", "simulator", "simulate"},
-      {"seed", "simulator", "simulate"},
-      {"leak_rate_hz", "simulator", "simulate"},
-      {"leak_jitter_fraction", "simulator", "simulate"},
-      {"cutoff_hz", "simulator", "simulate"},
-      {"hot_pixel_fraction", "simulator", "simulate"},
-      {"hot_pixel_rate_hz", "simulator", "simulate"},
-      {"flicker_led_hz", "simulator", "simulate"},
-      {"flicker_led_xy_px", "simulator", "simulate"},
-      {"flicker_led_radius_px", "simulator", "simulate"},
-      {"flicker_led_intensity", "simulator", "simulate"},
-      {"flicker_led_duty", "simulator", "simulate"},
-      {"mains_hz", "simulator", "simulate"},
-      {"mains_depth", "simulator", "simulate"},
-      {"mains_region_px", "simulator", "simulate"},
-      {"frame_gain", "simulator", "simulate"},
-      {"read_noise_dn", "simulator", "simulate"},
-      {"fpn_offset_dn", "simulator", "simulate"},
-      {"fpn_gain_sigma", "simulator", "simulate"},
-      // What a running command prints.
-      {"progress", "progress", "reconstruct"},
-      {"progress_interval_s", "progress", "*"},
-  };
+  help.groups = EvfsOptionGroups();
+  help.flags = EvfsFlagHelp();
   return help;
 }
 

@@ -1,6 +1,6 @@
-// The tables of `evfs --help` (app/command_line_help.h): the commands, the flag groups and, for
-// every flag of examples/evfs_main.cc, its group and the commands that read it. A new flag or
-// command is one row here.
+// The tables of `evfs --help` (app/command_line_help.h): the commands here, the flag groups and
+// flag rows from the option table (app/evfs_options.h). A new command is one row here, a new
+// flag one row of the option table.
 #ifndef EVFS_APP_EVFS_HELP_H_
 #define EVFS_APP_EVFS_HELP_H_
 

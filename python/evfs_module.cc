@@ -397,10 +397,9 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
   if (dtype != "float32" && dtype != "float64") {
     throw InvalidArgumentError("dtype must be 'float32' or 'float64', not '" + dtype + "'");
   }
-  ReconstructSettings settings = DefaultReconstructSettings();
-  ApplyReconstructOptions(options, &settings);
-  ResolveDenoise(&settings);
-  ReconstructRequest& request = settings.request;
+  OptionValues values;
+  ApplyPythonOptions(options, kReconstructKey, &values);
+  ReconstructRequest request = ReconstructRequestFromOptions(values, /*with_mode=*/false);
   request.data_label = kArraysLabel;
   request.mode = ParseMode(mode);
   request.first = IntArgument(first, "first");
@@ -437,8 +436,9 @@ py::dict ReconstructArrays(py::handle frames, py::handle frame_times, py::handle
 }
 
 py::dict SimulateArrays(py::handle frames, py::handle frame_times, py::handle options) {
-  SimulatorOptions simulator;
-  ApplySimulateOptions(options, &simulator);
+  OptionValues values;
+  ApplyPythonOptions(options, kSimulateKey, &values);
+  const SimulatorOptions simulator = SimulatorFromOptions(values);
   std::string error;
   if (!simulator.IsValid(&error)) throw InvalidArgumentError("simulator: " + error);
   RecordingInput input;
@@ -471,45 +471,31 @@ py::dict VideoFromPath(const std::string& data, const std::string& out, const py
                        const py::int_& frame_step, bool predict_tail, double predict_max_s,
                        double min_blur_exposure_s, bool blur_from_data, bool skip_bad_frames,
                        bool preview, bool report, bool resume, bool overwrite, py::handle options) {
-  ReconstructSettings settings = DefaultReconstructSettings();
-  ApplyReconstructOptions(options, &settings);
-  ResolveDenoise(&settings);
-  VideoRequest request;
-  request.data_path = data;
-  request.windows.first = IntArgument(first, "first");
-  request.windows.last = IntArgument(last, "last");
-  request.windows.frame_step = IntArgument(frame_step, "frame_step");
-  request.windows.predict_tail = predict_tail;
-  request.windows.predict_max_s = predict_max_s;
-  request.windows.min_blur_exposure_s = min_blur_exposure_s;
-  request.windows.blur_from_data = blur_from_data;
-  request.windows.exposure_s = settings.request.exposure_s;
-  request.skip_bad_frames = skip_bad_frames;
-  request.fps = fps;
-  request.jobs = IntArgument(jobs, "jobs");
-  request.preview = preview;
-  request.report = report;
-  request.resume = resume;
-  request.binning = settings.request.binning;
-  request.method = settings.request.method;
-  request.denoise = settings.request.denoise;
-  request.data_options = settings.request.data_options;
-  // What --resume compares: everything that decides the frames (not jobs, resume, overwrite).
-  request.settings =
-      std::string(py::str(ReconstructOptionValues(settings))) +
-      " first=" + std::to_string(request.windows.first) +
-      " last=" + std::to_string(request.windows.last) + " fps=" + std::to_string(fps) +
-      " frame_step=" + std::to_string(request.windows.frame_step) +
-      " predict_tail=" + std::to_string(predict_tail) +
-      " predict_max_s=" + std::to_string(predict_max_s) +
-      " min_blur_exposure_s=" + std::to_string(min_blur_exposure_s) +
-      " blur_from_data=" + std::to_string(blur_from_data) +
-      " skip_bad_frames=" + std::to_string(skip_bad_frames) + " preview=" + std::to_string(preview);
-  // A calibration file rewritten in place keeps its path: its bytes decide the model.
-  if (!settings.event_model_file.empty()) {
-    request.settings +=
-        " event_model_file_bytes=" + EventModelFileFingerprint(settings.event_model_file);
-  }
+  // The command line's flags of these names, over the options: the same request, and the same
+  // settings for resume to compare, as `evfs video` makes.
+  OptionValues values;
+  ApplyPythonOptions(options, kReconstructKey, &values);
+  const int first_frame = IntArgument(first, "first");
+  const int last_frame = IntArgument(last, "last");
+  const int step = IntArgument(frame_step, "frame_step");
+  const int windows_at_once = IntArgument(jobs, "jobs");
+  values.Set("data", data);
+  values.Set("first", first_frame);
+  values.Set("last", last_frame);
+  values.Set("fps", fps);
+  values.Set("jobs", windows_at_once);
+  values.Set("frame_step", step);
+  values.Set("predict_tail", predict_tail);
+  values.Set("predict_max_s", predict_max_s);
+  values.Set("min_blur_exposure_s", min_blur_exposure_s);
+  values.Set("blur_from_data", blur_from_data);
+  values.Set("skip_bad_frames", skip_bad_frames);
+  values.Set("preview", preview);
+  values.Set("report", report);
+  values.Set("resume", resume);
+  VideoRequest request = VideoRequestFromOptions(values);
+  // The command line reads --first=-1 as 0; Python's first has no such value.
+  request.windows.first = first_frame;
   std::string error;
   if (!request.IsValid(&error)) throw InvalidArgumentError(error);
   OutputOptions output;
@@ -608,12 +594,20 @@ PYBIND11_MODULE(evfs, m) {
         "float32 or float64 in [0, 1], float64 seconds), as `evfs simulate` does. options: "
         "simulate_defaults()'s keys. Returns the events as a dict like read()'s 'events'.");
   m.def("video", &evfs::VideoFromPath, py::arg("data"), py::arg("out"), py::kw_only(),
-        py::arg("first") = 0, py::arg("last") = -1, py::arg("fps") = 0.0, py::arg("jobs") = 0,
-        py::arg("frame_step") = 1, py::arg("predict_tail") = true, py::arg("predict_max_s") = 0.0,
-        py::arg("min_blur_exposure_s") = 0.0,
-        py::arg("blur_from_data") = evfs::VideoWindowOptions().blur_from_data,
-        py::arg("skip_bad_frames") = false, py::arg("preview") = false, py::arg("report") = false,
-        py::arg("resume") = false, py::arg("overwrite") = false, py::arg("options") = py::none(),
+        py::arg("first") = 0, py::arg("last") = evfs::OptionDefault<int32_t>("last"),
+        py::arg("fps") = evfs::OptionDefault<double>("fps"),
+        py::arg("jobs") = evfs::OptionDefault<int32_t>("jobs"),
+        py::arg("frame_step") = evfs::OptionDefault<int32_t>("frame_step"),
+        py::arg("predict_tail") = evfs::OptionDefault<bool>("predict_tail"),
+        py::arg("predict_max_s") = evfs::OptionDefault<double>("predict_max_s"),
+        py::arg("min_blur_exposure_s") = evfs::OptionDefault<double>("min_blur_exposure_s"),
+        py::arg("blur_from_data") = evfs::OptionDefault<bool>("blur_from_data"),
+        py::arg("skip_bad_frames") = evfs::OptionDefault<bool>("skip_bad_frames"),
+        py::arg("preview") = evfs::OptionDefault<bool>("preview"),
+        py::arg("report") = evfs::OptionDefault<bool>("report"),
+        py::arg("resume") = evfs::OptionDefault<bool>("resume"),
+        py::arg("overwrite") = evfs::OptionDefault<bool>("overwrite"),
+        py::arg("options") = py::none(),
         "A whole recording (`data`: a path read() accepts) to one high-framerate video in the "
         "folder `out`, as `evfs video` does (without MPI): out/frames/NNNNNN.png at a uniform "
         "`fps` (0: 10x the frame rate), timestamps.txt, summary.json, video.mp4 (report: also "
@@ -625,10 +619,9 @@ PYBIND11_MODULE(evfs, m) {
         "overwrite replaces an earlier evfs video output. options: reconstruct_defaults()'s "
         "keys. Returns a dict: 'path', 'windows', 'frames', 'fps', 'events', 'codec', ... ");
   m.def(
-      "reconstruct_defaults",
-      [] { return evfs::ReconstructOptionValues(evfs::DefaultReconstructSettings()); },
+      "reconstruct_defaults", [] { return evfs::PythonOptionDefaults(evfs::kReconstructKey); },
       "Every key reconstruct's options accept, with its default (that of the command line).");
   m.def(
-      "simulate_defaults", [] { return evfs::SimulateOptionValues(evfs::SimulatorOptions()); },
+      "simulate_defaults", [] { return evfs::PythonOptionDefaults(evfs::kSimulateKey); },
       "Every key simulate's options accept, with its default (that of the command line).");
 }

@@ -46,7 +46,8 @@ TEST(EvfsHelp, OverviewShowsCommandsAndEvfsFlagsByGroup) {
   for (const char* flag : {"logtostderr", "minloglevel", "flagfile", "tryfromenv"}) {
     EXPECT_FALSE(Contains(text, flag)) << flag;
   }
-  // Every flag of evfs_main.cc has its row (app/evfs_help.cc), and every row a flag.
+  // Every flag of evfs_main.cc has its row (the option table, app/evfs_options.cc), and every
+  // row a flag.
   EXPECT_FALSE(Contains(text, "\nother flags:\n")) << text.substr(text.find("\nother flags:"));
   EXPECT_FALSE(Contains(text, kHelpTableProblems)) << text.substr(text.find(kHelpTableProblems));
 }
