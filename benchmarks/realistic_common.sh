@@ -1,0 +1,51 @@
+# Sourced by benchmarks/realistic_variants.sh and realistic_video.sh.
+#
+#   parse_arguments SCRIPT BUILD_DIR DATA_DIR OUT_DIR [CROP_PX] [CLIP...]
+#   variant_flags LED_X LED_Y LED_RADIUS VARIANT
+
+# Sets build, data, out (created), crop, clips (clips.txt's when none given), evfs and helper.
+parse_arguments() {
+  local script=$1
+  shift
+  if [ $# -lt 3 ]; then
+    echo "usage: $script BUILD_DIR DATA_DIR OUT_DIR [CROP_PX] [CLIP...]" >&2
+    exit 2
+  fi
+  local here
+  here=$(cd "$(dirname "$script")" && pwd)
+  build=$(cd "$1" && pwd)
+  data=$(cd "$2" && pwd)
+  out=$3
+  crop=${4:-160}
+  shift $(( $# < 4 ? $# : 4 ))
+  clips=("$@")
+  [ ${#clips[@]} -gt 0 ] || mapfile -t clips < <(awk '!/^#/ && NF {print $1}' "$here/clips.txt")
+  evfs="$build/examples/evfs"
+  mkdir -p "$out"
+  out=$(cd "$out" && pwd)
+  helper="$here/realistic_variants_helper.py"
+}
+
+# The variants: name, then the simulate flags. The LED sits a quarter of the way into the frame
+# (its centre and radius: the first three arguments, set per clip by the caller); the parameters are the literature's (docs/model.md,
+# "Simulator defaults").
+variant_flags() {
+  local led="--flicker_led_hz=1000 --flicker_led_xy_px=$1,$2 --flicker_led_radius_px=$3"
+  local mains="--mains_hz=100 --mains_depth=0.3"
+  local hot="--hot_pixel_fraction=0.002 --hot_pixel_rate_hz=100"
+  local leak="--leak_rate_hz=0.1"
+  local saturation="--frame_gain=1.5"
+  local frame_noise="--read_noise_dn=2 --fpn_offset_dn=1 --fpn_gain_sigma=0.01"
+  local exposure="--exposure_s=0.02"
+  case $4 in
+    clean) echo "" ;;
+    hot) echo "$hot" ;;
+    leak) echo "$leak" ;;
+    flicker_led) echo "$led" ;;
+    mains) echo "$mains" ;;
+    saturation) echo "$saturation" ;;
+    frame_noise) echo "$frame_noise" ;;
+    exposure20ms) echo "$exposure" ;;
+    all) echo "$hot $leak $led $mains $saturation $frame_noise $exposure" ;;
+  esac
+}
