@@ -17,7 +17,7 @@ ProgramHelp MakeEvfsHelp() {
        "evfs calibrate finds on the first frames of the selection."},
       {"reconstruct",
        "--data=DIR --mode=interpolate|predict|deblur --first=I [--last=J] [--truth=K] --out=OUT "
-       "[--fps=N] [method, binning, model and solver flags]",
+       "[--fps=N] [--report] [method, binning, model and solver flags]",
        "Synthesise the latent frames between frames I and J from the frames and the events "
        "(paper §3), into OUT with their timestamps and a summary."},
       {"video",
@@ -134,7 +134,7 @@ ProgramHelp MakeEvfsHelp() {
       {"jobs", "solver", "video"},
       {"resume", "output", "video"},
       {"preview", "output", "video"},
-      {"report", "output", "video"},
+      {"report", "output", "reconstruct video"},
       {"predict_tail", "data", "video"},
       {"predict_max_s", "data", "video"},
       {"min_blur_exposure_s", "data", "video"},

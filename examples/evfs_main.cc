@@ -41,6 +41,7 @@
 #include "app/progress.h"
 #include "app/reconstruct_job.h"
 #include "app/reports.h"
+#include "app/run_report.h"
 #include "app/simulate_job.h"
 #include "app/version_report.h"
 #include "app/video_job.h"
@@ -280,8 +281,9 @@ DEFINE_bool(preview, false,
             "video: also preview.mp4, side by side: last observed frame | reconstruction | the "
             "step's events (red ON, blue OFF).");
 DEFINE_bool(report, false,
-            "video: also report.html, one offline page of the run: the video and preview, "
-            "events, iterations, solve time and PSNR per window, confidence maps, settings.");
+            "video, reconstruct: also report.html, one offline page of the run: the video and "
+            "preview, events, iterations, solve time and PSNR per window (reconstruct: the "
+            "frames, truth and baseline, the solve), confidence maps, event model, settings.");
 DEFINE_bool(predict_tail, true,
             "video: predict after the recording's last frame up to the last event.");
 DEFINE_double(predict_max_s, 0.0,
@@ -651,6 +653,8 @@ int RunDenoise() {
   return 0;
 }
 
+std::string VideoSettings();
+
 int RunReconstruct(ProgressReporter* progress) {
   Require(!FLAGS_data.empty(), "reconstruct needs --data=DIR or --data=FILE.h5");
   Require(!FLAGS_out.empty(), "reconstruct needs --out=DIR");
@@ -666,6 +670,7 @@ int RunReconstruct(ProgressReporter* progress) {
   ReconstructResult result = RunReconstruction(request);
   progress->StartStage("write");
   WriteReconstruction(request, &result, out.staging());
+  if (FLAGS_report) WriteReconstructionReport(result, out.staging(), VideoSettings());
   out.Commit();
 
   PrintReconstruction(request, result, out.path(), stdout);
