@@ -1,11 +1,12 @@
 // libFuzzer target: evfs' own ROS 1 bag code in memory (io/rosbag/format.h), without
-// rosbag_storage, so that it runs thousands of inputs a second where rosbag_fuzzer (the whole
-// reader, a rosbag::Bag per input) runs about a hundred. An input that starts as a bag goes
-// through CheckBagStructure, then every chunk through DecompressChunk and CheckChunkRecords,
-// and every message record an index entry points at through both decoders; any other input is
-// decoded as one dvs_msgs/EventArray and as one sensor_msgs/Image. Every input must give a
-// result or an evfs::Error whose message is one short line, and what a check accepts must hold
-// what it promises (the records and events lie inside the bytes; an image has its size).
+// rosbag_storage, so that it runs several times as many inputs a second as rosbag_fuzzer (the
+// whole reader, a rosbag::Bag and its queries per input). An input that starts as a bag goes
+// through CheckBagStructure (the ranges it hands back must lie in the input), then every chunk
+// through DecompressChunk and CheckChunkRecords, and every message record an index entry points
+// at through both decoders; any other input is decoded as one dvs_msgs/EventArray and as one
+// sensor_msgs/Image. Every input must give a result or an evfs::Error whose message is one short
+// line, and what a check accepts must hold what it promises (the records and events lie inside
+// the bytes; an image has its size).
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -73,7 +74,10 @@ void DecodeChunkMessages(const rf::BagChunk& chunk, const uint8_t* bytes, size_t
 
 void FuzzBag(const uint8_t* data, size_t size) {
   try {
-    const rf::BagLayout layout = rf::CheckBagStructure(kPath, data, size);
+    const rf::BagLayout layout =
+        rf::CheckBagStructure(kPath, data, size, [size](size_t offset, size_t length) {
+          Require(offset <= size && length <= size - offset, "a released range past the file");
+        });
     for (const rf::BagChunk& chunk : layout.chunks) {
       Require(chunk.data_begin + chunk.data_size <= size, "a chunk past the file");
       if (chunk.compression == "none") {
