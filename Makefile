@@ -37,10 +37,11 @@ test-sanitize: deps
 # cut from the shared data; stops at the first finding, whose input is left in
 # build-fuzz/tests/fuzz/findings/. libhdf5 itself hangs or runs out of memory on some corrupt
 # files (README.md, Robustness), so the HDF5 target runs in fork mode, which records those in
-# findings/ and goes on; a crash still stops it.
+# findings/ and goes on; a crash still stops it. rosbag_format_fuzzer (evfs' own bag checks and
+# message decoders, in memory) starts from rosbag_fuzzer's seeds.
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS = event_text_fuzzer frame_list_fuzzer hdf5_io_fuzzer aedat4_fuzzer aedat_legacy_fuzzer \
-  rosbag_fuzzer
+  rosbag_fuzzer rosbag_format_fuzzer
 FUZZ_DIR = build-fuzz/tests/fuzz
 
 fuzz:
@@ -52,10 +53,11 @@ fuzz:
 	  name=$${target%_fuzzer}; \
 	  mkdir -p $(FUZZ_DIR)/corpus/$$name $(FUZZ_DIR)/findings; \
 	  mode=; if [ $$name = hdf5_io ]; then mode=-fork=1; fi; \
+	  seeds=$$name; if [ $$name = rosbag_format ]; then seeds=rosbag; fi; \
 	  echo "fuzz: $$target for $(FUZZ_SECONDS) s"; \
 	  $(FUZZ_DIR)/$$target $$mode -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
 	    -print_final_stats=1 -artifact_prefix=$(FUZZ_DIR)/findings/$$name- \
-	    $(FUZZ_DIR)/corpus/$$name $(FUZZ_DIR)/seeds/$$name || exit 1; \
+	    $(FUZZ_DIR)/corpus/$$name $(FUZZ_DIR)/seeds/$$seeds || exit 1; \
 	done
 
 # Trains the residual denoiser from scratch (about an hour on 2 cores): pairs made by evfs's own

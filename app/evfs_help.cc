@@ -18,7 +18,7 @@ ProgramHelp MakeEvfsHelp() {
        "evfs calibrate finds on the first frames of the selection."},
       {"reconstruct",
        "--data=DIR --mode=interpolate|predict|deblur --first=I [--last=J] [--truth=K] --out=OUT "
-       "[--fps=N] [method, binning, model and solver flags]",
+       "[--fps=N] [--report] [method, binning, model and solver flags]",
        "Synthesise the latent frames between frames I and J from the frames and the events "
        "(paper §3), into OUT with their timestamps and a summary."},
       {"video",

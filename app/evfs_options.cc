@@ -445,9 +445,10 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "video: also preview.mp4, side by side: last observed frame | reconstruction | the "
           "step's events (red ON, blue OFF).",
           EVFS_OPTION_FIELD(video.preview)),
-      Row("report", "output", "video", kNotInFingerprint, Bool(false),
-          "video: also report.html, one offline page of the run: the video and preview, events, "
-          "iterations, solve time and PSNR per window, confidence maps, settings.",
+      Row("report", "output", "reconstruct video", kNotInFingerprint, Bool(false),
+          "video, reconstruct: also report.html, one offline page of the run: the video and "
+          "preview, events, iterations, solve time and PSNR per window (reconstruct: the "
+          "frames, truth and baseline, the solve), confidence maps, event model, settings.",
           EVFS_OPTION_FIELD(video.report)),
       Row("predict_tail", "data", "video", 0, Bool(true),
           "video: predict after the recording's last frame up to the last event.",

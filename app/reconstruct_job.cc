@@ -279,6 +279,7 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   if (request.truth >= 0) {
     TruthScore& truth = result.truth;
     truth.index = request.truth;
+    truth.image = truth_image;
     truth.latent_index = latent.NearestFrame(truth.timestamp_ns);
     const Image estimate = latent.frame(truth.latent_index);
     truth.psnr = Psnr(estimate, truth_image);

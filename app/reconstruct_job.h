@@ -68,6 +68,7 @@ struct TruthScore {
   int latent_index = -1;                            // latent frame nearest to it
   double psnr = 0.0, ssim = 0.0;                    // reconstruction against truth
   double baseline_psnr = 0.0, baseline_ssim = 0.0;  // initialisation (blend or copy) against truth
+  Image image;                                      // the truth frame itself
 };
 
 struct StageTimes {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/image_io.h"
 
 namespace evfs {
 namespace {
@@ -31,6 +32,8 @@ constexpr int kMarginBottom = 40;
 // Thumbnails of the confidence maps: enough to see how it changes along the run, few enough to
 // keep the page light (each is a reference to a PNG in OUT, not a copy).
 constexpr int kMaxConfidenceThumbnails = 6;
+// Thumbnails of one reconstruction's frames, for the same reason.
+constexpr int kMaxFrameThumbnails = 8;
 
 std::string Format(double value) {
   char buffer[32];
@@ -67,6 +70,149 @@ std::string Table(const Json& object) {
   std::string rows;
   AppendRows(object, "", &rows);
   return "<table>\n" + rows + "</table>\n";
+}
+
+// `count` of `files` evenly spread from the first to the last, as <figure>s.
+std::string Thumbnails(const std::vector<std::string>& files, size_t count) {
+  count = std::min(files.size(), count);
+  std::string strip = "<div class=\"strip\">\n";
+  for (size_t i = 0; i < count; ++i) {
+    const size_t pick = count == 1 ? 0 : i * (files.size() - 1) / (count - 1);
+    strip += "<figure><img src=\"" + HtmlEscape(files[pick]) + "\" alt=\"" +
+             HtmlEscape(files[pick]) + "\"><figcaption>" + HtmlEscape(files[pick]) +
+             "</figcaption></figure>\n";
+  }
+  return strip + "</div>\n";
+}
+
+// The confidence maps' thumbnails and what summary.json says of them; "" without maps.
+std::string ConfidenceSection(const Json& summary, const std::vector<std::string>& files) {
+  if (files.empty()) return "";
+  std::string section = "<h2>Confidence maps</h2>\n" + Thumbnails(files, kMaxConfidenceThumbnails);
+  if (summary.contains("confidence")) section += Table(summary["confidence"]);
+  return section;
+}
+
+// The command line's settings, "name=value name=value ...", one key each; the event model's own
+// (thresholds, log offset, model) also go to `model`.
+Json SettingsFlags(const std::string& settings, Json* model) {
+  Json flags = Json::object();
+  std::istringstream words(settings);
+  std::string word;
+  while (words >> word) {
+    const size_t equals = word.find('=');
+    const std::string name = word.substr(0, equals);
+    const std::string value = equals == std::string::npos ? "" : word.substr(equals + 1);
+    flags[name] = value;
+    for (const char* topic : {"threshold", "log_offset", "model", "contrast", "sigma_"}) {
+      if (name.find(topic) != std::string::npos) (*model)[name] = value;
+    }
+  }
+  return flags;
+}
+
+// The page up to its first section: `title` in the tab, `heading` on the page.
+std::string PageStart(const std::string& title, const std::string& heading) {
+  std::string page;
+  page += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  page += "<title>" + HtmlEscape(title) + "</title>\n";
+  page +=
+      "<style>\nbody{font-family:sans-serif;margin:16px;max-width:1240px}\n"
+      ".media,.plots,.strip{display:flex;flex-wrap:wrap;gap:12px}\n"
+      "figure{margin:0}video{max-width:600px;width:100%;background:#000}\n"
+      ".strip img{width:180px;image-rendering:pixelated;border:1px solid #ccc}\n"
+      "table{border-collapse:collapse;font-size:13px}th,td{border:1px solid #ddd;"
+      "padding:2px 6px;text-align:left;vertical-align:top}\n"
+      "svg.plot{font-size:11px;border:1px solid #eee}\n#selfcheck{display:none}\n</style>\n";
+  page += "</head>\n<body>\n<h1>" + HtmlEscape(heading) + "</h1>\n";
+  return page;
+}
+
+// The event model and settings sections, the self-check and the page's end.
+std::string PageEnd(const Json& model, const Json& settings) {
+  std::string page;
+  page += "<h2>Event model</h2>\n" +
+          (model.empty() ? std::string("<p>not reported by this run</p>\n") : Table(model));
+  page += "<h2>Settings</h2>\n" + Table(settings);
+  // A self-check, run only when the page is opened as report.html#selfcheck (the browser test
+  // does): plays the video if there is one, counts the plots and the pictures that did not load
+  // and lists every resource the page loaded.
+  page += R"(<pre id="selfcheck"></pre>
+<script>
+if (location.hash === '#selfcheck') {
+  window.addEventListener('load', function () {
+    var report = {plots: 0, empty_plots: 0, images: 0, broken_images: 0, video_ready: 0,
+                  video_time: 0, resources: []};
+    document.querySelectorAll('svg.plot').forEach(function (svg) {
+      report.plots++;
+      var drawn = svg.querySelector('polyline[points]:not([points=""])') ||
+                  svg.querySelector('.no-data');
+      if (!drawn || svg.getBoundingClientRect().width === 0) report.empty_plots++;
+    });
+    document.querySelectorAll('img').forEach(function (img) {
+      report.images++;
+      if (!img.complete || img.naturalWidth === 0) report.broken_images++;
+    });
+    var video = document.getElementById('video');
+    var finish = function () {
+      report.video_ready = video ? video.readyState : -1;
+      report.video_time = video ? video.currentTime : -1;
+      report.resources = performance.getEntriesByType('resource').map(function (e) {
+        return e.name;
+      });
+      document.querySelectorAll('[src],[href]').forEach(function (element) {
+        report.resources.push(element.src || element.href);
+      });
+      document.getElementById('selfcheck').textContent = 'SELFCHECK ' + JSON.stringify(report);
+    };
+    if (!video) { finish(); return; }
+    video.muted = true;
+    video.play().catch(function (e) { report.play_error = String(e); });
+    setTimeout(finish, 1500);
+  });
+}
+</script>
+)";
+  page += "</body>\n</html>\n";
+  return page;
+}
+
+// The text of OUT/summary.json.
+std::string ReadSummary(const fs::path& out) {
+  const fs::path summary_path = out / "summary.json";
+  std::ifstream in(summary_path, std::ios::binary);
+  if (!in) throw InputError(InputError::Kind::kMissingFile, summary_path.string(), 0, "a file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The PNGs of OUT/`folder`, as paths relative to OUT, sorted (their names are frame numbers).
+std::vector<std::string> PngFiles(const fs::path& out, const std::string& folder) {
+  std::vector<std::string> files;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(out / folder, error)) {
+    if (entry.path().extension() == ".png")
+      files.push_back(folder + "/" + entry.path().filename().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+void WritePage(const fs::path& out, const std::string& page) {
+  const fs::path path = out / "report.html";
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  file << page;
+  file.close();
+  if (!file) throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "a writable file");
+}
+
+Json ParseSummary(const std::string& summary_json) {
+  Json summary = Json::parse(summary_json, nullptr, /*allow_exceptions=*/false);
+  if (summary.is_discarded() || !summary.is_object()) {
+    throw InputError(InputError::Kind::kMalformed, "summary.json", 0, "a JSON object");
+  }
+  return summary;
 }
 
 }  // namespace
@@ -178,10 +324,7 @@ std::string LinePlotSvg(const std::string& title, const std::string& x_label,
 
 std::string RenderRunReport(const std::string& summary_json,
                             const std::vector<std::string>& confidence_files) {
-  const Json summary = Json::parse(summary_json, nullptr, /*allow_exceptions=*/false);
-  if (summary.is_discarded() || !summary.is_object()) {
-    throw InputError(InputError::Kind::kMalformed, "summary.json", 0, "a JSON object");
-  }
+  const Json summary = ParseSummary(summary_json);
   const Json windows =
       summary.contains("windows") && summary["windows"].is_array() ? summary["windows"] : Json();
 
@@ -235,21 +378,6 @@ std::string RenderRunReport(const std::string& summary_json,
                        "preview: last observed frame | reconstruction | events");
   }
 
-  std::string confidence;
-  if (!confidence_files.empty()) {
-    const size_t count =
-        std::min(confidence_files.size(), static_cast<size_t>(kMaxConfidenceThumbnails));
-    confidence += "<div class=\"strip\">\n";
-    for (size_t i = 0; i < count; ++i) {
-      const size_t pick = count == 1 ? 0 : i * (confidence_files.size() - 1) / (count - 1);
-      const std::string& file = confidence_files[pick];
-      confidence += "<figure><img src=\"" + HtmlEscape(file) + "\" alt=\"" + HtmlEscape(file) +
-                    "\"><figcaption>" + HtmlEscape(file) + "</figcaption></figure>\n";
-    }
-    confidence += "</div>\n";
-    if (summary.contains("confidence")) confidence += Table(summary["confidence"]);
-  }
-
   // The event model: what the first solved window used (each window reports its own).
   Json model = Json::object();
   for (const Json& window : windows) {
@@ -261,106 +389,126 @@ std::string RenderRunReport(const std::string& summary_json,
   }
   if (summary.contains("model")) model["run"] = summary["model"];
 
-  // The command line's settings, "name=value name=value ...", one row each; the event model's
-  // own (thresholds, log offset, model) also go to the model's table.
+  // The command line's settings, one row each; the event model's own also in its table.
   Json settings = Json::object();
   Json flags = Json::object();
   for (auto it = summary.begin(); it != summary.end(); ++it) {
     if (it.key() == "settings" && it->is_string()) {
-      std::istringstream words(it->get<std::string>());
-      std::string word;
-      while (words >> word) {
-        const size_t equals = word.find('=');
-        const std::string name = word.substr(0, equals);
-        const std::string value = equals == std::string::npos ? "" : word.substr(equals + 1);
-        flags[name] = value;
-        for (const char* topic : {"threshold", "log_offset", "model", "contrast", "sigma_"}) {
-          if (name.find(topic) != std::string::npos) model[name] = value;
-        }
-      }
+      flags = SettingsFlags(it->get<std::string>(), &model);
     } else if (it.key() != "windows" && it.key() != "exposures") {
       settings[it.key()] = *it;
     }
   }
   if (!flags.empty()) settings["flags"] = flags;
 
-  std::string page;
-  page += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  page += "<title>evfs run: " + HtmlEscape(Scalar(summary.value("data", Json("")))) + "</title>\n";
-  page +=
-      "<style>\nbody{font-family:sans-serif;margin:16px;max-width:1240px}\n"
-      ".media,.plots,.strip{display:flex;flex-wrap:wrap;gap:12px}\n"
-      "figure{margin:0}video{max-width:600px;width:100%;background:#000}\n"
-      ".strip img{width:180px;image-rendering:pixelated;border:1px solid #ccc}\n"
-      "table{border-collapse:collapse;font-size:13px}th,td{border:1px solid #ddd;"
-      "padding:2px 6px;text-align:left;vertical-align:top}\n"
-      "svg.plot{font-size:11px;border:1px solid #eee}\n#selfcheck{display:none}\n</style>\n";
-  page += "</head>\n<body>\n";
-  page += "<h1>evfs " + HtmlEscape(Scalar(summary.value("command", Json("run")))) + ": " +
-          HtmlEscape(Scalar(summary.value("data", Json("")))) + "</h1>\n";
+  const std::string data = Scalar(summary.value("data", Json("")));
+  std::string page = PageStart(
+      "evfs run: " + data, "evfs " + Scalar(summary.value("command", Json("run"))) + ": " + data);
   page += "<h2>Video</h2>\n<div class=\"media\">\n" + media + "</div>\n";
   page += "<h2>Along the recording</h2>\n<div class=\"plots\">\n" + plots + "</div>\n";
-  if (!confidence.empty()) page += "<h2>Confidence maps</h2>\n" + confidence;
-  page += "<h2>Event model</h2>\n" +
-          (model.empty() ? std::string("<p>not reported by this run</p>\n") : Table(model));
-  page += "<h2>Settings</h2>\n" + Table(settings);
-  // A self-check, run only when the page is opened as report.html#selfcheck (the browser test
-  // does): plays the video, counts the plots and lists every resource the page loaded.
-  page += R"(<pre id="selfcheck"></pre>
-<script>
-if (location.hash === '#selfcheck') {
-  window.addEventListener('load', function () {
-    var report = {plots: 0, empty_plots: 0, video_ready: 0, video_time: 0, resources: []};
-    document.querySelectorAll('svg.plot').forEach(function (svg) {
-      report.plots++;
-      var drawn = svg.querySelector('polyline[points]:not([points=""])') ||
-                  svg.querySelector('.no-data');
-      if (!drawn || svg.getBoundingClientRect().width === 0) report.empty_plots++;
-    });
-    var video = document.getElementById('video');
-    var finish = function () {
-      report.video_ready = video ? video.readyState : -1;
-      report.video_time = video ? video.currentTime : -1;
-      report.resources = performance.getEntriesByType('resource').map(function (e) {
-        return e.name;
-      });
-      document.querySelectorAll('[src],[href]').forEach(function (element) {
-        report.resources.push(element.src || element.href);
-      });
-      document.getElementById('selfcheck').textContent = 'SELFCHECK ' + JSON.stringify(report);
-    };
-    if (!video) { finish(); return; }
-    video.muted = true;
-    video.play().catch(function (e) { report.play_error = String(e); });
-    setTimeout(finish, 1500);
-  });
-}
-</script>
-)";
-  page += "</body>\n</html>\n";
-  return page;
+  page += ConfidenceSection(summary, confidence_files);
+  return page + PageEnd(model, settings);
 }
 
 void WriteRunReport(const std::string& out_folder) {
   const fs::path out(out_folder);
-  const fs::path summary_path = out / "summary.json";
-  std::ifstream in(summary_path, std::ios::binary);
-  if (!in) throw InputError(InputError::Kind::kMissingFile, summary_path.string(), 0, "a file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  std::vector<std::string> confidence;
-  std::error_code error;
-  for (const auto& entry : fs::directory_iterator(out / "confidence", error)) {
-    if (entry.path().extension() == ".png")
-      confidence.push_back("confidence/" + entry.path().filename().string());
+  WritePage(out, RenderRunReport(ReadSummary(out), PngFiles(out, "confidence")));
+}
+
+std::string RenderReconstructionReport(const std::string& summary_json,
+                                       const ReconstructionPictures& pictures,
+                                       const std::string& settings_text) {
+  const Json summary = ParseSummary(summary_json);
+  const std::string mode = Scalar(summary.value("mode", Json("")));
+  const std::string data = Scalar(summary.value("data", Json("")));
+  std::string page =
+      PageStart("evfs reconstruct: " + data, "evfs reconstruct " + mode + ": " + data);
+
+  page += "<h2>Synthesised frames</h2>\n";
+  page += pictures.frames.empty() ? std::string("<p>no frames</p>\n")
+                                  : Thumbnails(pictures.frames, kMaxFrameThumbnails);
+  page += "<p>" + std::to_string(pictures.frames.size()) +
+          " frames in frames/, their times in timestamps.txt</p>\n";
+
+  // The scored frame beside the truth and the baseline the score compares against.
+  if (summary.contains("truth") && summary["truth"].is_object() && !pictures.truth.empty()) {
+    const Json& truth = summary["truth"];
+    const std::string baseline = Scalar(truth.value("baseline", Json("baseline")));
+    const auto figure = [](const std::string& file, const std::string& caption) {
+      return "<figure><img src=\"" + HtmlEscape(file) + "\" alt=\"" + HtmlEscape(caption) +
+             "\"><figcaption>" + HtmlEscape(caption) + "</figcaption></figure>\n";
+    };
+    page += "<h2>Against the truth</h2>\n<div class=\"strip\">\n";
+    page += figure(pictures.truth, "truth: frame " + Scalar(truth.value("index", Json(-1))));
+    page += figure(pictures.estimate, "evfs: PSNR " + Format(NumberOr(truth, "psnr")) + " dB");
+    page += figure(pictures.baseline,
+                   baseline + ": PSNR " + Format(NumberOr(truth, "baseline_psnr")) + " dB");
+    page += "</div>\n" + Table(truth);
   }
-  std::sort(confidence.begin(), confidence.end());
-  const std::string page = RenderRunReport(text.str(), confidence);
-  const fs::path path = out / "report.html";
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  file << page;
-  file.close();
-  if (!file) throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "a writable file");
+
+  // The solve: its iterations and times, and with --checkpoints its cost (and PSNR) per
+  // iteration.
+  page += "<h2>Solve</h2>\n";
+  Json solve = Json::object();
+  for (const char* key : {"solved", "iterations", "initial_cost", "final_cost", "time_s"}) {
+    if (summary.contains(key)) solve[key] = summary[key];
+  }
+  if (summary.contains("solver")) solve["solver"] = summary["solver"];
+  page += Table(solve);
+  if (summary.contains("checkpoints") && summary["checkpoints"].is_array()) {
+    std::vector<double> iteration, cost, psnr;
+    for (const Json& checkpoint : summary["checkpoints"]) {
+      iteration.push_back(NumberOr(checkpoint, "iteration"));
+      cost.push_back(NumberOr(checkpoint, "cost"));
+      psnr.push_back(NumberOr(checkpoint, "psnr"));
+    }
+    page += "<div class=\"plots\">\n";
+    page += LinePlotSvg("Cost per iteration", "iteration", "cost",
+                        {{"cost", "#1f77b4", iteration, cost}});
+    if (summary.contains("truth")) {
+      page += LinePlotSvg("PSNR against the truth per iteration", "iteration", "PSNR (dB)",
+                          {{"evfs", "#2ca02c", iteration, psnr}});
+    }
+    page += "</div>\n";
+  }
+  page += ConfidenceSection(summary, pictures.confidence);
+
+  Json model = summary.contains("model") ? summary["model"] : Json::object();
+  Json settings = Json::object();
+  for (auto it = summary.begin(); it != summary.end(); ++it) {
+    if (it.key() != "checkpoints" && it.key() != "model") settings[it.key()] = *it;
+  }
+  const Json flags = SettingsFlags(settings_text, &model);
+  if (!flags.empty()) settings["flags"] = flags;
+  return page + PageEnd(model, settings);
+}
+
+void WriteReconstructionReport(const ReconstructResult& result, const std::string& out_folder,
+                               const std::string& settings) {
+  const fs::path out(out_folder);
+  ReconstructionPictures pictures;
+  pictures.frames = PngFiles(out, "frames");
+  pictures.confidence = PngFiles(out, "confidence");
+  if (result.has_truth && result.output.num_frames() > 0) {
+    // The truth and the baseline are not among the outputs: the page gets its own copies,
+    // 8-bit, in OUT/report/; the estimate is the output frame nearest the truth's time.
+    const fs::path folder = out / "report";
+    std::error_code error;
+    fs::create_directories(folder, error);
+    if (error) {
+      throw InputError(InputError::Kind::kUnwritable, folder.string(), 0, "a writable folder");
+    }
+    WriteGreyPng8((folder / "truth.png").string(), result.truth.image);
+    WriteGreyPng8((folder / "baseline.png").string(),
+                  result.baseline.frame(result.truth.latent_index));
+    const int nearest = result.output.NearestFrame(result.truth.timestamp_ns);
+    pictures.truth = "report/truth.png";
+    pictures.baseline = "report/baseline.png";
+    if (nearest >= 0 && nearest < static_cast<int>(pictures.frames.size())) {
+      pictures.estimate = pictures.frames[static_cast<size_t>(nearest)];
+    }
+  }
+  WritePage(out, RenderReconstructionReport(ReadSummary(out), pictures, settings));
 }
 
 }  // namespace evfs

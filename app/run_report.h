@@ -1,11 +1,15 @@
 // report.html: one page that shows a finished `evfs video` run (its video and preview, the
 // windows' events, iterations, solve time and PSNR along the recording, the confidence maps, the
-// event model and the settings), read from the run's summary.json.
+// event model and the settings), or one `evfs reconstruct` window (its frames, the truth and
+// the baseline when scored, the solve, the confidence maps, the event model and the settings),
+// read from the run's summary.json. The two pages share their layout, tables and self-check.
 #ifndef EVFS_APP_RUN_REPORT_H_
 #define EVFS_APP_RUN_REPORT_H_
 
 #include <string>
 #include <vector>
+
+#include "app/reconstruct_job.h"
 
 namespace evfs {
 
@@ -34,6 +38,28 @@ std::string RenderRunReport(const std::string& summary_json,
 
 /// Writes OUT/report.html from OUT/summary.json and OUT/confidence/*.png.
 void WriteRunReport(const std::string& out_folder);
+
+/// The pictures of one reconstruction's page, as paths relative to OUT.
+struct ReconstructionPictures {
+  std::vector<std::string> frames;      // the synthesised frames, in time order
+  std::vector<std::string> confidence;  // their confidence maps
+  /// Scored (--truth): the truth frame, the output frame nearest it and the baseline (blend or
+  /// copy) at that time; "" otherwise.
+  std::string truth, estimate, baseline;
+};
+
+/// The page for the reconstruction whose summary.json holds `summary_json`; `settings` is the
+/// command line's "name=value name=value ..." (evfs' own flags). Throws InputError when
+/// `summary_json` is not JSON.
+std::string RenderReconstructionReport(const std::string& summary_json,
+                                       const ReconstructionPictures& pictures,
+                                       const std::string& settings);
+
+/// Writes OUT/report.html for the reconstruction `result` written into `out_folder` (by
+/// WriteReconstruction: frames/, confidence/, summary.json), and with a truth OUT/report/
+/// truth.png and baseline.png, 8-bit.
+void WriteReconstructionReport(const ReconstructResult& result, const std::string& out_folder,
+                               const std::string& settings);
 
 }  // namespace evfs
 

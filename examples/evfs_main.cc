@@ -42,6 +42,7 @@
 #include "app/progress.h"
 #include "app/reconstruct_job.h"
 #include "app/reports.h"
+#include "app/run_report.h"
 #include "app/simulate_job.h"
 #include "app/version_report.h"
 #include "app/video_job.h"
@@ -232,6 +233,9 @@ int RunReconstruct(ProgressReporter* progress) {
   ReconstructResult result = RunReconstruction(request);
   progress->StartStage("write");
   WriteReconstruction(request, &result, out.staging());
+  if (Options().Bool("report")) {
+    WriteReconstructionReport(result, out.staging(), VideoFingerprint(Options()));
+  }
   out.Commit();
 
   PrintReconstruction(request, result, out.path(), stdout);

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <utility>
@@ -58,6 +59,18 @@ MappedFile MappedFile::FromMemory(std::string path, const char* data, size_t siz
 }
 
 MappedFile::~MappedFile() { Unmap(); }
+
+void MappedFile::Release(size_t offset, size_t size) const {
+  if (!mapped_ || offset >= size_) return;
+  const size_t end = offset + std::min(size, size_ - offset);
+  const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
+  // Whole pages only: the pages at either end may hold bytes outside the range still in use.
+  const size_t first = (offset + page - 1) / page * page;
+  const size_t last = end == size_ ? end : end / page * page;
+  if (first >= last) return;
+  // Advice on a read-only private mapping of a file: its pages are read again from the file.
+  ::madvise(const_cast<char*>(data_) + first, last - first, MADV_DONTNEED);
+}
 
 MappedFile::MappedFile(MappedFile&& other) noexcept
     : path_(std::move(other.path_)),

@@ -30,6 +30,12 @@ class MappedFile {
   const char* data() const { return data_; }
   size_t size() const { return size_; }
 
+  /// Drops the whole pages inside bytes [offset, offset + size) from this process's resident
+  /// memory (madvise MADV_DONTNEED; the kernel's page cache keeps them and a later read maps them
+  /// in again), so that one pass over a file larger than memory holds only the pages in use.
+  /// Nothing to do for FromMemory's bytes. The range is clamped to the file.
+  void Release(size_t offset, size_t size) const;
+
  private:
   MappedFile() = default;
   void Unmap();

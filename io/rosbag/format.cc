@@ -1,5 +1,8 @@
 #include "io/rosbag/format.h"
 
+#include <bzlib.h>
+#include <roslz4/lz4s.h>
+
 #include <cstring>
 #include <map>
 #include <opencv2/core.hpp>
@@ -32,6 +35,9 @@ constexpr uint32_t kMaxLz4Expansion = 255;
 constexpr uint64_t kLz4FrameSlackBytes = 1024;
 constexpr size_t kIndexEntryBytes = 12;     // time (8) and offset (4)
 constexpr size_t kChunkInfoEntryBytes = 8;  // connection id (4) and count (4)
+// How many bytes the walk over a bag's records reads before it hands them to ReleaseBytes: a
+// madvise call per record would cost more than the walk.
+constexpr size_t kReleaseStepBytes = size_t{8} << 20;
 
 uint32_t ReadU32(const uint8_t* p) {
   return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
@@ -56,8 +62,9 @@ class BagChecker {
  public:
   // `context` opens every message: "" for the file, "the chunk at byte N, uncompressed, " for
   // the bytes of a chunk.
-  BagChecker(const std::string& path, const uint8_t* data, size_t size, std::string context = "")
-      : path_(path), data_(data), size_(size), context_(std::move(context)) {}
+  BagChecker(const std::string& path, const uint8_t* data, size_t size, std::string context = "",
+             const ReleaseBytes* release = nullptr)
+      : path_(path), data_(data), size_(size), context_(std::move(context)), release_(release) {}
 
   BagLayout Check() {
     if (size_ < kMagicBytes || std::memcmp(data_, kMagic, kMagicBytes) != 0) {
@@ -65,11 +72,16 @@ class BagChecker {
     }
     std::vector<Record> records;
     std::map<size_t, size_t> record_at_offset;
+    size_t released = 0;
     for (size_t offset = kMagicBytes; offset < size_;) {
       const Record record = ReadRecord(offset, size_, "the file");
       record_at_offset[offset] = records.size();
       records.push_back(record);
       offset = record.data_end;
+      if (release_ != nullptr && offset - released >= kReleaseStepBytes) {
+        (*release_)(released, offset - released);
+        released = offset;
+      }
     }
     if (records.empty() || records.front().op != kOpBagHeader) {
       Fail(kMagicBytes, "the first record is not the bag header (truncated file?)");
@@ -130,6 +142,9 @@ class BagChecker {
         Fail(chunk_pos, "a chunk without the index data its chunk info declares");
       }
       layout.chunks.push_back(CheckChunk(records, chunk, count, connections));
+      if (release_ != nullptr) {
+        (*release_)(records[chunk].offset, records[chunk + count].data_end - records[chunk].offset);
+      }
     }
     return layout;
   }
@@ -313,6 +328,7 @@ class BagChecker {
   const uint8_t* data_;
   size_t size_;
   std::string context_;
+  const ReleaseBytes* release_;  // may be null
 };
 
 // Reads a serialised message field by field, failing on a short message.
@@ -363,8 +379,9 @@ class MessageReader {
 
 }  // namespace
 
-BagLayout CheckBagStructure(const std::string& path, const uint8_t* data, size_t size) {
-  return BagChecker(path, data, size).Check();
+BagLayout CheckBagStructure(const std::string& path, const uint8_t* data, size_t size,
+                            const ReleaseBytes& release) {
+  return BagChecker(path, data, size, "", release ? &release : nullptr).Check();
 }
 
 void CheckChunkRecords(const std::string& path, const BagChunk& chunk, const uint8_t* data,
@@ -372,6 +389,28 @@ void CheckChunkRecords(const std::string& path, const BagChunk& chunk, const uin
   BagChecker(path, data, size,
              "the chunk at byte " + std::to_string(chunk.offset) + ", uncompressed, ")
       .CheckChunkRecords(chunk);
+}
+
+ChunkBytes DecompressChunk(const std::string& path, const BagChunk& chunk, const uint8_t* file) {
+  ChunkBytes out;
+  // Not value-initialised: a declared size the data does not fill stays unmapped.
+  out.data.reset(new uint8_t[chunk.size]);
+  char* input = const_cast<char*>(reinterpret_cast<const char*>(file + chunk.data_begin));
+  unsigned int length = chunk.size;
+  char* output = reinterpret_cast<char*>(out.data.get());
+  const bool ok =
+      chunk.compression == "bz2"
+          ? BZ2_bzBuffToBuffDecompress(output, &length, input,
+                                       static_cast<unsigned int>(chunk.data_size), 0, 0) == BZ_OK
+          : roslz4_buffToBuffDecompress(input, static_cast<unsigned int>(chunk.data_size), output,
+                                        &length) == ROSLZ4_OK;
+  if (!ok) {
+    throw InputError(InputError::Kind::kMalformed, path, 0,
+                     "byte " + std::to_string(chunk.offset) + ": a " + chunk.compression +
+                         " chunk that does not decompress (corrupt?)");
+  }
+  out.size = length;
+  return out;
 }
 
 int64_t EventArray::t_ns(uint32_t index) const {

@@ -19,6 +19,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,6 +61,10 @@ struct BagLayout {
   std::vector<BagChunk> chunks;  // in the order of the chunk infos
 };
 
+/// Told the byte ranges of the file a check has finished with (it may read them again later, as
+/// any mapped file allows), in steps of megabytes: the reader drops their pages from memory.
+using ReleaseBytes = std::function<void(size_t offset, size_t size)>;
+
 /// Walks the records of the `size` bytes at `data` (the bag `path`, for messages) and checks
 /// everything rosbag_storage relies on without checking it when it opens a bag: every record
 /// and header field lies inside the file, the bag header's index position falls on a record,
@@ -66,13 +72,27 @@ struct BagLayout {
 /// at a chunk followed by its index data, every connection named is declared and every index
 /// offset lies inside its chunk. Throws InputError naming the byte offset where the file stops
 /// making sense, and for an unindexed bag (index_pos 0: a recording that was cut short).
-BagLayout CheckBagStructure(const std::string& path, const uint8_t* data, size_t size);
+/// `release` (may be empty) is told the ranges the walk is done with.
+BagLayout CheckBagStructure(const std::string& path, const uint8_t* data, size_t size,
+                            const ReleaseBytes& release = {});
 
 /// Checks the `size` bytes at `data`, `chunk` uncompressed, before rosbag_storage reads its
 /// messages (it trusts the lengths it finds there): they are `chunk.size` bytes of whole records,
 /// and every index entry of the chunk points at a message record. Throws InputError.
 void CheckChunkRecords(const std::string& path, const BagChunk& chunk, const uint8_t* data,
                        size_t size);
+
+/// A chunk's data uncompressed; pages the decompressor did not write are never touched, so a
+/// chunk that declares more than it holds costs only what it holds.
+struct ChunkBytes {
+  std::unique_ptr<uint8_t[]> data;
+  size_t size = 0;
+};
+
+/// The data of `chunk` of the bag whose bytes start at `file`, a bz2 or LZ4 chunk, uncompressed
+/// as rosbag_storage decompresses it (at most chunk.size bytes; CheckChunkRecords checks that
+/// they are exactly that many). Throws InputError naming `path` when they do not decompress.
+ChunkBytes DecompressChunk(const std::string& path, const BagChunk& chunk, const uint8_t* file);
 
 /// The header and event count of a dvs_msgs/EventArray; the events stay in the message bytes.
 struct EventArray {

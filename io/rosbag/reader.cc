@@ -1,12 +1,10 @@
 // Reading ROS 1 bags: RosbagDataSource (io/rosbag.h).
-#include <bzlib.h>
 #include <console_bridge/console.h>
 #include <ros/serialization.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
 #include <rosbag/query.h>
 #include <rosbag/view.h>
-#include <roslz4/lz4s.h>
 
 #include <algorithm>
 #include <cctype>
@@ -68,6 +66,15 @@ int64_t SaturatingAdd(int64_t a, int64_t b) {
   return a + b;
 }
 
+// pluginlib loads rosbag's encryption plugin library (dlopen, relocations, static initialisers)
+// with every rosbag::Bag and unloads it (dlclose, finalisers) with the last one alive, which
+// costs more than checking and opening a small bag. A Bag held for the rest of the process, never
+// opened, keeps the library loaded, so each bag after the first costs neither.
+void KeepBagPluginsLoaded() {
+  static const rosbag::Bag* const keeper = new rosbag::Bag();
+  (void)keeper;
+}
+
 }  // namespace
 
 bool IsRosbagPath(const std::string& path) {
@@ -93,9 +100,15 @@ class RosbagDataSource::File {
   File(const std::string& path, const DataSourceOptions& options) : path_(path), file_(path) {
     // rosbag_storage logs through console_bridge; evfs reports its errors itself, in one line.
     console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
-    layout_ = rf::CheckBagStructure(path, bytes(), file_.size());
+    // The walk touches a page or more per record; the pages it is done with leave memory as it
+    // goes, so that opening a bag holds a few megabytes of it, not a share of the file.
+    layout_ =
+        rf::CheckBagStructure(path, bytes(), file_.size(),
+                              [this](size_t offset, size_t size) { file_.Release(offset, size); });
+    file_.Release(0, file_.size());
     chunk_checked_.assign(layout_.chunks.size(), false);
     Guard([&] {
+      KeepBagPluginsLoaded();
       bag_ = std::make_unique<rosbag::Bag>();
       bag_->open(path, rosbag::bagmode::Read);
     });
@@ -276,32 +289,14 @@ class RosbagDataSource::File {
       if (chunk.compression == "none") {
         rf::CheckChunkRecords(path_, chunk, bytes() + chunk.data_begin, chunk.data_size);
       } else {
-        const std::vector<uint8_t> uncompressed = Decompress(chunk);
-        rf::CheckChunkRecords(path_, chunk, uncompressed.data(), uncompressed.size());
+        const rf::ChunkBytes uncompressed = rf::DecompressChunk(path_, chunk, bytes());
+        rf::CheckChunkRecords(path_, chunk, uncompressed.data.get(), uncompressed.size);
       }
+      // rosbag_storage reads the chunk again through its own buffer: the mapped pages are done
+      // with, and a pass over every chunk then holds one chunk's pages, not the file's.
+      file_.Release(chunk.data_begin, chunk.data_size);
       chunk_checked_[i] = true;
     }
-  }
-
-  // The data of a bz2 or LZ4 chunk uncompressed, as rosbag_storage decompresses it.
-  std::vector<uint8_t> Decompress(const rf::BagChunk& chunk) const {
-    std::vector<uint8_t> out(chunk.size);
-    char* input = const_cast<char*>(reinterpret_cast<const char*>(bytes() + chunk.data_begin));
-    unsigned int length = chunk.size;
-    const bool ok =
-        chunk.compression == "bz2"
-            ? BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(out.data()), &length, input,
-                                         static_cast<unsigned int>(chunk.data_size), 0, 0) == BZ_OK
-            : roslz4_buffToBuffDecompress(input, static_cast<unsigned int>(chunk.data_size),
-                                          reinterpret_cast<char*>(out.data()),
-                                          &length) == ROSLZ4_OK;
-    if (!ok) {
-      Fail(InputError::Kind::kMalformed, "byte " + std::to_string(chunk.offset) + ": a " +
-                                             chunk.compression +
-                                             " chunk that does not decompress (corrupt?)");
-    }
-    out.resize(length);
-    return out;
   }
 
   std::string MessageName(const std::string& topic, const ros::Time& time) const {

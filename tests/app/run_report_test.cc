@@ -79,5 +79,86 @@ TEST(LinePlotSvg, EmptyPlotSaysNoData) {
 
 TEST(RunReport, RejectsNonJson) { EXPECT_THROW(RenderRunReport("not json", {}), InputError); }
 
+// A summary.json as evfs reconstruct writes it with --truth and --checkpoints (shortened), with a
+// data path a page must not read as markup.
+const char kReconstructionSummary[] = R"({
+  "mode": "interpolate",
+  "data": "<img src=x onerror=alert(1)>",
+  "events": 1234,
+  "solver": {"name": "ceres_lm", "termination": "CONVERGENCE"},
+  "model": {"event_model": "log", "alpha": 0.21},
+  "solved": true,
+  "iterations": 3,
+  "initial_cost": 10.0,
+  "final_cost": 2.0,
+  "time_s": {"read": 0.1, "solve": 0.25, "total": 0.5},
+  "confidence": {"folder": "confidence"},
+  "truth": {"index": 1, "psnr": 31.5, "baseline": "blend", "baseline_psnr": 27.25},
+  "checkpoints": [{"iteration": 0, "cost": 10.0, "psnr": 27.0},
+                  {"iteration": 1, "cost": 4.0, "psnr": 30.0},
+                  {"iteration": 3, "cost": 2.0, "psnr": 31.5}]
+})";
+
+ReconstructionPictures Pictures(int frames) {
+  ReconstructionPictures pictures;
+  for (int i = 0; i < frames; ++i) {
+    pictures.frames.push_back("frames/00000" + std::to_string(i) + ".png");
+    pictures.confidence.push_back("confidence/00000" + std::to_string(i) + ".png");
+  }
+  pictures.truth = "report/truth.png";
+  pictures.estimate = pictures.frames.empty() ? "" : pictures.frames[frames / 2];
+  pictures.baseline = "report/baseline.png";
+  return pictures;
+}
+
+TEST(ReconstructionReport, ShowsTheFramesTheTruthAndTheSolve) {
+  const std::string page = RenderReconstructionReport(kReconstructionSummary, Pictures(3),
+                                                      "max_iterations=5 threshold_pos=0.2");
+  for (const char* file : {"frames/000000.png", "frames/000002.png", "report/truth.png",
+                           "report/baseline.png", "confidence/000001.png"}) {
+    EXPECT_NE(page.find(std::string("src=\"") + file + "\""), std::string::npos) << file;
+  }
+  EXPECT_NE(page.find("evfs: PSNR 31.5 dB"), std::string::npos);
+  EXPECT_NE(page.find("blend: PSNR 27.25 dB"), std::string::npos);
+  // Cost and PSNR per iteration, one line each.
+  EXPECT_EQ(Count(page, "<svg class=\"plot\""), 2);
+  EXPECT_EQ(Count(page, "<polyline"), 2);
+  EXPECT_NE(page.find("<th>iterations</th><td>3</td>"), std::string::npos);
+  EXPECT_NE(page.find("<th>time_s.solve</th><td>0.25</td>"), std::string::npos);
+  EXPECT_NE(page.find("<th>event_model</th><td>log</td>"), std::string::npos);
+  EXPECT_NE(page.find("<th>threshold_pos</th><td>0.2</td>"), std::string::npos);
+  EXPECT_NE(page.find("<th>flags.max_iterations</th><td>5</td>"), std::string::npos);
+}
+
+TEST(ReconstructionReport, WithoutTruthOrCheckpointsHasNeither) {
+  std::string summary(kReconstructionSummary);
+  const size_t truth = summary.find("  \"truth\"");
+  summary = summary.substr(0, truth) + "  \"x\": 0\n}";
+  const std::string page = RenderReconstructionReport(summary, Pictures(2), "");
+  EXPECT_EQ(page.find("Against the truth"), std::string::npos);
+  EXPECT_EQ(page.find("report/truth.png"), std::string::npos);
+  EXPECT_EQ(Count(page, "<svg class=\"plot\""), 0);
+  EXPECT_NE(page.find("frames/000001.png"), std::string::npos);
+}
+
+TEST(ReconstructionReport, ThumbnailsAreFewAndSpanTheWindow) {
+  const ReconstructionPictures pictures = Pictures(9 * 3);
+  const std::string page = RenderReconstructionReport(kReconstructionSummary, pictures, "");
+  // Eight frame thumbnails from the first to the last, six confidence maps, three scored.
+  EXPECT_EQ(Count(page, "<img "), 8 + 6 + 3);
+  EXPECT_NE(page.find("src=\"" + pictures.frames.front() + "\""), std::string::npos);
+  EXPECT_NE(page.find("src=\"" + pictures.frames.back() + "\""), std::string::npos);
+}
+
+TEST(ReconstructionReport, MakesNoRequestOutsideItsFolderAndEscapes) {
+  const std::string page = RenderReconstructionReport(kReconstructionSummary, Pictures(2), "");
+  EXPECT_EQ(page.find("http://"), std::string::npos);
+  EXPECT_EQ(page.find("https://"), std::string::npos);
+  EXPECT_EQ(page.find("<img src=x"), std::string::npos);
+  EXPECT_NE(page.find("&lt;img src=x onerror=alert(1)&gt;"), std::string::npos);
+  EXPECT_EQ(Count(page, "<script>"), 1);
+  EXPECT_THROW(RenderReconstructionReport("[1, 2]", Pictures(1), ""), InputError);
+}
+
 }  // namespace
 }  // namespace evfs

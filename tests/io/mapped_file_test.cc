@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 #include <utility>
 
@@ -46,6 +47,39 @@ TEST(MappedFileTest, FromMemoryWrapsTheBytesWithoutCopying) {
   // Moving and destroying must not try to unmap memory that was never mapped.
   MappedFile moved(std::move(file));
   EXPECT_EQ(moved.data(), bytes.data());
+}
+
+// This process's resident pages of mapped files, in kB (/proc/self/status RssFile).
+long ResidentFileKb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("RssFile:", 0) == 0) return std::stol(line.substr(8));
+  }
+  return -1;
+}
+
+TEST(MappedFileTest, ReleaseDropsTheResidentPagesAndKeepsTheBytes) {
+  const std::string path = test::ScratchDir("mapped_release") + "/data.bin";
+  // Large enough that its pages stand out from the rest of the process's mapped files.
+  constexpr size_t kBytes = 16 << 20;
+  std::string content(kBytes, '\0');
+  for (size_t i = 0; i < kBytes; ++i) content[i] = static_cast<char>(i * 7 + i / 4096);
+  test::WriteFile(path, content);
+  const MappedFile file(path);
+  const long before_kb = ResidentFileKb();
+  ASSERT_GE(before_kb, 0) << "no RssFile in /proc/self/status";
+  long sum = 0;
+  for (size_t i = 0; i < kBytes; i += 4096) sum += file.data()[i];
+  const long touched_kb = ResidentFileKb();
+  EXPECT_GE(touched_kb - before_kb, static_cast<long>(kBytes / 1024 / 2)) << sum;
+  file.Release(0, kBytes);
+  EXPECT_LT(ResidentFileKb(), touched_kb - static_cast<long>(kBytes / 1024 / 2));
+  EXPECT_EQ(std::string(file.data(), file.size()), content);
+  // A range past the end, or around it, is clamped.
+  file.Release(kBytes - 10, 100);
+  file.Release(kBytes + 1, 100);
+  EXPECT_EQ(std::string(file.data(), file.size()), content);
 }
 
 TEST(MappedFileTest, MissingFileOrFolderIsAnInputError) {

@@ -9,6 +9,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -265,6 +266,36 @@ TEST(RosbagTest, MessagesQuoteTheFileWithoutControlBytes) {
     EXPECT_TRUE(std::none_of(message.begin(), message.end(), [](char c) {
       return static_cast<unsigned char>(c) < 0x20;
     })) << message;
+  }
+}
+
+// The structure check tells the reader which bytes it is done with (their pages then leave
+// memory): ranges inside the file, covering every chunk, and the same layout as without it.
+TEST(RosbagTest, TheStructureCheckHandsBackEveryChunkItRead) {
+  EVFS_REQUIRE_SHARED_DATA(data_dir);
+  EVFS_REQUIRE_PYTHON_ROSBAG();
+  const std::string bag = WriteBag(data_dir + "/eslnet_cups_blur", "--compression none");
+  std::ifstream in(bag, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto* data = reinterpret_cast<const uint8_t*>(bytes.data());
+  std::vector<std::pair<size_t, size_t>> released;
+  const rosbag_format::BagLayout layout = rosbag_format::CheckBagStructure(
+      bag, data, bytes.size(),
+      [&](size_t offset, size_t size) { released.emplace_back(offset, size); });
+  EXPECT_EQ(layout.chunks.size(),
+            rosbag_format::CheckBagStructure(bag, data, bytes.size()).chunks.size());
+  ASSERT_GT(layout.chunks.size(), 1u) << "a bag of one chunk tests little here";
+  for (const auto& [offset, size] : released) {
+    EXPECT_LE(offset + size, bytes.size()) << offset << " + " << size;
+  }
+  for (const rosbag_format::BagChunk& chunk : layout.chunks) {
+    EXPECT_TRUE(std::any_of(released.begin(), released.end(),
+                            [&](const auto& range) {
+                              return range.first <= chunk.offset &&
+                                     chunk.data_begin + chunk.data_size <=
+                                         range.first + range.second;
+                            }))
+        << "the chunk at byte " << chunk.offset;
   }
 }
 
