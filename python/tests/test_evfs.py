@@ -383,9 +383,9 @@ def same_default(kind, text, value):
 
 # Flags of `evfs reconstruct` that are arguments of evfs.reconstruct, or that have no meaning
 # without files and a terminal (--allow_outside_paths guards the frame paths of a recording's
-# images.txt; evfs.reconstruct takes arrays).
+# images.txt, --report writes a page into OUT; evfs.reconstruct takes and returns arrays).
 RECONSTRUCT_ARGUMENTS = {"data", "mode", "first", "last", "truth", "out", "overwrite",
-                         "progress", "progress_interval_s", "allow_outside_paths"}
+                         "progress", "progress_interval_s", "allow_outside_paths", "report"}
 # evfs.simulate returns the events of the frames as given: the light sources and the frame
 # effects of `evfs simulate` (which writes the frames it records) are the command's alone.
 SIMULATE_ARGUMENTS = {"frames", "out", "overwrite", "progress_interval_s", "exposure_s",

@@ -117,7 +117,8 @@ TEST(EvfsOptionsTest, EveryReconstructOptionReachesPython) {
                                            "overwrite",
                                            "progress",
                                            "progress_interval_s",
-                                           "allow_outside_paths"};
+                                           "allow_outside_paths",
+                                           "report"};
   const std::set<std::string> video_arguments = {"jobs",
                                                  "resume",
                                                  "preview",
