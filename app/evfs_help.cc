@@ -130,6 +130,8 @@ ProgramHelp MakeEvfsHelp() {
       {"denoise", "denoiser", "reconstruct video"},
       {"denoiser", "denoiser", "reconstruct denoise video"},
       {"denoise_consistency", "denoiser", "reconstruct video"},
+      {"denoise_gate", "denoiser", "reconstruct video"},
+      {"denoise_gate_tau", "denoiser", "reconstruct video"},
       // evfs video's own.
       {"jobs", "solver", "video"},
       {"resume", "output", "video"},

@@ -266,6 +266,12 @@ DEFINE_bool(
     "part of the denoiser's correction that would change a frame's exposure mean is "
     "taken out; BENCHMARKS.md \"Residual denoiser\"); false applies the network's correction "
     "as it is.");
+DEFINE_bool(denoise_gate, evfs::DenoiseRequest().gate,
+            "--denoise=once: weigh the network's correction per pixel by the solve's predicted "
+            "error sigma (OUT/confidence), w = sigma^2 / (sigma^2 + tau^2), so that it corrects "
+            "only where the solve is unsure.");
+DEFINE_double(denoise_gate_tau, evfs::DenoiseRequest().gate_tau,
+              "--denoise_gate: tau in intensity units, >= 0; 0: 3 x the frames' noise sigma.");
 DEFINE_string(in, "", "denoise: the reconstruction folder (written by evfs reconstruct).");
 DEFINE_double(progress_interval_s, 5.0,
               "While a command runs, a line on stderr (stage, "
@@ -628,6 +634,8 @@ ReconstructRequest RequestFromFlags(bool with_mode = true) {
 
   request.denoise.denoiser.weights_path = FLAGS_denoiser;
   request.denoise.consistency = FLAGS_denoise_consistency;
+  request.denoise.gate = FLAGS_denoise_gate;
+  request.denoise.gate_tau = FLAGS_denoise_gate_tau;
   if (FLAGS_denoise == "auto") {
     request.denoise.mode = AutoDenoiseMode(FLAGS_denoiser);
   } else {

@@ -304,6 +304,10 @@ const std::vector<Option<R>>& ReconstructOptionTable() {
        [](py::handle v, R* s) {
          s->request.denoise.consistency = ToBool("denoise_consistency", v);
        }},
+      {"denoise_gate", [](const R& s) { return py::cast(s.request.denoise.gate); },
+       [](py::handle v, R* s) { s->request.denoise.gate = ToBool("denoise_gate", v); }},
+      {"denoise_gate_tau", [](const R& s) { return py::cast(s.request.denoise.gate_tau); },
+       [](py::handle v, R* s) { s->request.denoise.gate_tau = ToDouble("denoise_gate_tau", v); }},
   };
   return table;
 }
