@@ -271,7 +271,7 @@ DEFINE_bool(denoise_gate, evfs::DenoiseRequest().gate,
             "error sigma (OUT/confidence), w = sigma^2 / (sigma^2 + tau^2), so that it corrects "
             "only where the solve is unsure.");
 DEFINE_double(denoise_gate_tau, evfs::DenoiseRequest().gate_tau,
-              "--denoise_gate: tau in intensity units, >= 0; 0: 3 x the frames' noise sigma.");
+              "--denoise_gate: tau in intensity units, >= 0; 0: 24 x the frames' noise sigma.");
 DEFINE_string(in, "", "denoise: the reconstruction folder (written by evfs reconstruct).");
 DEFINE_double(progress_interval_s, 5.0,
               "While a command runs, a line on stderr (stage, "
