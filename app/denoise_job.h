@@ -65,7 +65,7 @@ struct DenoiseRequest {
 /// τ² is the variance of the network's own error, independent of the solve's: on real
 /// recordings, which it never saw in training, that error is far above the frames' noise. 24
 /// puts τ near 0.08 on the DAVIS240 windows (noise 0.0034–0.0056), where the real windows'
-/// SSIM stops falling (models/README.md, "The confidence gate and realistic pairs"); at 3 it
+/// SSIM stops falling (benchmarks/denoiser_gate_windows.sh); at 3 it
 /// lost up to 0.010 SSIM there. A pixel whose predicted error is the frames' noise alone keeps
 /// under 1 % of the correction.
 inline constexpr double kGateNoiseMultiple = 24.0;
