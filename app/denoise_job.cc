@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include "io/decimal_seconds.h"
 #include "io/image_io.h"
 #include "scene/activity_mask.h"
+#include "scene/confidence.h"
 
 namespace evfs {
 namespace {
@@ -90,6 +92,10 @@ DenoiseMode AutoDenoiseMode(const std::string& weights_path) {
 }
 
 std::unique_ptr<Denoiser> LoadDenoiser(const DenoiseRequest& request) {
+  if (!(request.gate_tau >= 0.0) || !std::isfinite(request.gate_tau)) {
+    throw InvalidArgumentError("--denoise_gate_tau must be >= 0 (0: from the frames' noise), not " +
+                               std::to_string(request.gate_tau));
+  }
   if (request.mode == DenoiseMode::kNone) return nullptr;
   DenoiserOptions options = request.denoiser;
   if (options.weights_path.empty()) {
@@ -114,9 +120,22 @@ DenoiseRegion SolvedRegion(const Scene& scene, const MethodOptions& method, bool
   return region;
 }
 
+std::unique_ptr<DenoiseGate> MakeDenoiseGate(const DenoiseRequest& request, const Scene& scene,
+                                             const MethodOptions& method, const MethodResult& run) {
+  if (!request.gate || request.mode != DenoiseMode::kOnce) return nullptr;
+  auto gate = std::make_unique<DenoiseGate>();
+  ConfidenceModel model;
+  gate->sigma = PredictErrorSigma(scene, run.video, ConfidenceFor(method, run), &model);
+  gate->tau = request.gate_tau > 0.0
+                  ? request.gate_tau
+                  : std::max(kMinGateTau, kGateNoiseMultiple * model.frame_noise_sigma);
+  return gate;
+}
+
 DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
                                  const DenoiseRegion& region, const Scene* observed,
-                                 const Image* truth, int truth_index, Video* latent) {
+                                 const Image* truth, int truth_index, Video* latent,
+                                 const DenoiseGate* gate) {
   DenoiseRecord record;
   record.mode = mode;
   record.weights_path = denoiser.weights_path();
@@ -129,6 +148,10 @@ DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
     record.ssim_before = Ssim(before, *truth);
   }
   Video denoised = denoiser.Apply(*latent, region, &record.stats);
+  if (gate != nullptr) {
+    denoised = GateCorrection(*latent, denoised, gate->sigma, gate->tau);
+    record.gate_tau = gate->tau;
+  }
   if (observed != nullptr) {
     record.consistent = true;
     record.consistency = KeepFramesConsistent(*observed, *latent, &denoised);
@@ -203,6 +226,7 @@ Json DenoiseJson(const DenoiseRecord& record) {
     } else {
       json["consistency"] = nullptr;
     }
+    json["gate_tau"] = record.gate_tau > 0.0 ? Json(record.gate_tau) : Json(nullptr);
   }
   if (record.scored) {
     json["psnr_before"] = record.psnr_before;

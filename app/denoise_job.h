@@ -51,7 +51,39 @@ struct DenoiseRequest {
   PlugAndPlayOptions pnp;
   /// Mode once: keep the correction consistent with the scene's frames (KeepFramesConsistent).
   bool consistency = true;
+  /// Mode once: weigh the correction by the solve's predicted error σ (GateCorrection in
+  /// denoiser/denoiser.h, σ from scene/confidence.h), so that the network corrects only where
+  /// the solve is unsure.
+  bool gate = false;
+  /// τ of the gate in intensity units, >= 0: the predicted error at which half the correction is
+  /// kept; 0: kGateNoiseMultiple times the observed frames' noise sigma (ConfidenceModel), at
+  /// least kMinGateTau.
+  double gate_tau = 0.0;
 };
+
+/// The automatic gate's τ in units of the frames' noise sigma. In the Wiener reading of the gate
+/// τ² is the variance of the network's own error, independent of the solve's: on real
+/// recordings, which it never saw in training, that error is far above the frames' noise. 24
+/// puts τ near 0.08 on the DAVIS240 windows (noise 0.0034–0.0056), where the real windows'
+/// SSIM stops falling (benchmarks/denoiser_gate_windows.sh); at 3 it
+/// lost up to 0.010 SSIM there. A pixel whose predicted error is the frames' noise alone keeps
+/// under 1 % of the correction.
+inline constexpr double kGateNoiseMultiple = 24.0;
+/// The least automatic τ: one 8-bit level, the noise of quantised frames without read noise.
+inline constexpr double kMinGateTau = 1.0 / 255.0;
+
+/// The confidence gate of a solve (DenoiseRequest::gate): the predicted error of its latent
+/// frames and τ.
+struct DenoiseGate {
+  Video sigma;
+  double tau = 0.0;
+};
+
+/// The gate `request` asks for on `run` (the solve of `scene` by `method`): σ from
+/// PredictErrorSigma, τ as DenoiseRequest::gate_tau says. Null when the request has no gate or
+/// its mode is not once.
+std::unique_ptr<DenoiseGate> MakeDenoiseGate(const DenoiseRequest& request, const Scene& scene,
+                                             const MethodOptions& method, const MethodResult& run);
 
 /// What denoising did, for summary.json.
 struct DenoiseRecord {
@@ -68,6 +100,8 @@ struct DenoiseRecord {
   /// Mode once with a scene to keep consistent with: what the projection took out.
   bool consistent = false;
   FrameConsistency consistency;
+  /// Mode once with a confidence gate: its τ (0: no gate).
+  double gate_tau = 0.0;
 };
 
 /// The denoiser `request` asks for, loaded (null for mode none). Throws InvalidArgumentError
@@ -81,10 +115,12 @@ DenoiseRegion SolvedRegion(const Scene& scene, const MethodOptions& method, bool
 /// Applies `denoiser` to `latent` in place at `region`, scoring frame `truth_index` against
 /// `truth` before it does when `truth` is not null. When `observed` is not null (the scene
 /// `latent` reconstructs), the correction is scaled by what its frames support
-/// (CalibrateResidual); null applies it as the network gives it.
+/// (CalibrateResidual); null applies it as the network gives it. When `gate` is not null the
+/// network's correction is weighted by it (GateCorrection) before that.
 DenoiseRecord DenoiseLatentVideo(const Denoiser& denoiser, DenoiseMode mode,
                                  const DenoiseRegion& region, const Scene* observed,
-                                 const Image* truth, int truth_index, Video* latent);
+                                 const Image* truth, int truth_index, Video* latent,
+                                 const DenoiseGate* gate = nullptr);
 
 /// Throws InvalidArgumentError (one line) when `mode` cannot follow `method`: plug & play
 /// needs the Ceres problem (ceres_lm), whose quadratic prior couples it to the denoiser.

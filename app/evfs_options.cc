@@ -434,6 +434,16 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "BENCHMARKS.md \"Residual denoiser\"); false applies the network's correction as it "
           "is.",
           EVFS_OPTION_FIELD(reconstruct.denoise.consistency)),
+      Row("denoise_gate", "denoiser", "reconstruct video", kReconstructKey,
+          Bool(DenoiseRequest().gate),
+          "--denoise=once: weigh the network's correction per pixel by the solve's predicted "
+          "error sigma (OUT/confidence), w = sigma^2 / (sigma^2 + tau^2), so that it corrects "
+          "only where the solve is unsure.",
+          EVFS_OPTION_FIELD(reconstruct.denoise.gate)),
+      Row("denoise_gate_tau", "denoiser", "reconstruct video", kReconstructKey,
+          Double(DenoiseRequest().gate_tau),
+          "--denoise_gate: tau in intensity units, >= 0; 0: 24 x the frames' noise sigma.",
+          EVFS_OPTION_FIELD(reconstruct.denoise.gate_tau)),
       Row("jobs", "solver", "video", kNotInFingerprint, Int32(0),
           "video: windows solved at once; 0: every core.", EVFS_OPTION_FIELD(video.jobs)),
       Row("resume", "output", "video", kNotInFingerprint, Bool(false),

@@ -264,9 +264,11 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
       result.denoise = PlugAndPlayLatentVideo(*denoiser, scene, method, request.denoise.pnp, region,
                                               truth, truth_latent, &result.run);
     } else {
+      const std::unique_ptr<DenoiseGate> gate =
+          MakeDenoiseGate(request.denoise, scene, request.method, result.run);
       result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region,
                                           request.denoise.consistency ? &scene : nullptr, truth,
-                                          truth_latent, &result.run.video);
+                                          truth_latent, &result.run.video, gate.get());
     }
   }
   ApplySharpFrameSeams(scene, request.method, &result.run);

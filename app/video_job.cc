@@ -379,9 +379,11 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     const auto denoise_start = Clock::now();
     DenoiseRegion region = SolvedRegion(scene, context.method, run.solved);
     region.frames = FramesTheOutputNeeds(window, scene, run.video, context, begin, end);
-    denoise_record =
-        DenoiseLatentVideo(*context.denoiser, request.denoise.mode, region,
-                           request.denoise.consistency ? &scene : nullptr, nullptr, -1, &run.video);
+    const std::unique_ptr<DenoiseGate> gate =
+        MakeDenoiseGate(request.denoise, scene, context.method, run);
+    denoise_record = DenoiseLatentVideo(*context.denoiser, request.denoise.mode, region,
+                                        request.denoise.consistency ? &scene : nullptr, nullptr, -1,
+                                        &run.video, gate.get());
     denoise_s = SecondsSince(denoise_start);
   }
   ApplySharpFrameSeams(scene, context.method, &run);

@@ -21,16 +21,7 @@ cd "$(dirname "$0")/.."
 evfs="$build/examples/evfs"
 mkdir -p "$scratch"
 
-# name data mode first last truth
-windows=(
-  "slider_70-71 slider_depth_70_71 predict 0 1 1"
-  "shapes_13-14 shapes_rotation_13_20 predict 0 1 1"
-  "shapes_18-19 shapes_rotation_13_20 predict 2 3 3"
-  "shapes_19-20 shapes_rotation_13_20 predict 3 4 4"
-  "shapes_18,20-19 shapes_rotation_13_20 interpolate 2 4 3"
-  "street_0,2-1 aedat4_davis346_street/sample.aedat4 interpolate 0 2 1"
-  "street_1,3-2 aedat4_davis346_street/sample.aedat4 interpolate 1 3 2"
-)
+mapfile -t windows < <(grep -v "^#" benchmarks/real_windows.txt)
 echo "| window | baseline | evfs PSNR | with denoiser | integration | baseline PSNR | evfs SSIM | with denoiser | integration | baseline SSIM | within predicted sigma | saturated px | flickering px |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for entry in "${windows[@]}"; do

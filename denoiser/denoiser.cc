@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
@@ -452,6 +453,35 @@ Video Denoiser::Apply(const Video& video, const DenoiseRegion& region, DenoiseSt
   local.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stats != nullptr) *stats = local;
   return output;
+}
+
+Video GateCorrection(const Video& input, const Video& corrected, const Video& sigma, double tau) {
+  if (!(tau > 0.0) || !std::isfinite(tau)) {
+    throw InvalidArgumentError("the denoiser gate's tau must be positive and finite, not " +
+                               std::to_string(tau));
+  }
+  const auto same_size = [&input](const Video& other) {
+    return other.num_frames() == input.num_frames() && other.height() == input.height() &&
+           other.width() == input.width();
+  };
+  if (!same_size(corrected) || !same_size(sigma)) {
+    throw InvalidArgumentError(
+        "the denoiser gate needs the input, the correction and sigma of one size");
+  }
+  Video gated = input;
+  const double tau_squared = tau * tau;
+  for (int t = 0; t < input.num_frames(); ++t) {
+    const double* in = input.frame_data(t);
+    const double* out = corrected.frame_data(t);
+    const double* error = sigma.frame_data(t);
+    double* result = gated.frame_data(t);
+    for (int64_t p = 0; p < input.pixels_per_frame(); ++p) {
+      const double variance = error[p] * error[p];
+      if (variance == 0.0) continue;  // a sure pixel keeps its value exactly
+      result[p] = in[p] + variance / (variance + tau_squared) * (out[p] - in[p]);
+    }
+  }
+  return gated;
 }
 
 }  // namespace evfs

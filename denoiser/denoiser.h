@@ -99,6 +99,18 @@ class Denoiser {
   std::unique_ptr<Networks> networks_;
 };
 
+/// The confidence gate: `input` plus the correction `corrected` − `input` weighted per pixel by
+///   w = σ² / (σ² + τ²),
+/// σ the solve's predicted one-sigma error of the pixel (scene/confidence.h) and τ > 0 the error
+/// at which half the correction is kept. Where the solve is sure (σ ≪ τ) the pixel keeps the
+/// solve's value, and σ = 0 keeps it bit for bit; where it is unsure (σ ≫ τ) the pixel takes the
+/// network's value. A smooth weight rather than a threshold, so that the output does not jump
+/// between neighbouring pixels whose σ straddles τ; its form is the Wiener gain of a correction
+/// whose own error has variance τ² blended with an estimate whose error has variance σ².
+/// Throws InvalidArgumentError when the three videos differ in size or τ is not positive and
+/// finite.
+Video GateCorrection(const Video& input, const Video& corrected, const Video& sigma, double tau);
+
 }  // namespace evfs
 
 #endif  // EVFS_DENOISER_DENOISER_H_

@@ -7,12 +7,19 @@
 //   make_denoiser_pairs --out=DIR --samples=N [--seed=S] [--first_sample=I]
 //                       [--photos=a.jpg,b.png] [--videos=a.avi] [--clips=DIR,DIR]
 //                       [--synthetic_weight=1 --photo_weight=1 --video_weight=1 --clip_weight=1]
+//                       [--realistic=0]
 //
 // Sources: synthetic scenes (events/scene_synthesizer.h); photographs moved by a smooth affine
 // motion (a camera pan with a little rotation and zoom) rendered at 1 kHz; video files read
 // with OpenCV and taken as 240 fps; folders in the text layout (images.txt) taken at their own
 // timestamps. What the sources are is the caller's choice: the validation recordings must not
 // be among them (models/README.md, tools/train_denoiser/train.sh).
+//
+// Realistic samples (a share `--realistic` of them) record the clip with the effects of a real
+// sensor (`evfs simulate`'s: hot pixels, leak, photoreceptor bandwidth, a mains lamp, frame gain
+// that saturates, fixed-pattern and read noise): the pair's truth is then what the same sensor
+// would record without temporal read noise (its lamp, gain, saturation and fixed pattern kept),
+// since a real recording's truth frame is such a frame.
 //
 // Output (one folder, written whole or not at all, io/output_target.h):
 //   pair_NNNNNNN_K.npy  float32, shape (3, H, W): the DMR latent frame, the ground truth at its
@@ -45,6 +52,8 @@
 #include "core/metrics.h"
 #include "core/option_checker.h"
 #include "core/time.h"
+#include "events/flicker.h"
+#include "events/frame_effects.h"
 #include "events/random.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
@@ -67,6 +76,9 @@ DEFINE_double(synthetic_weight, 1.0, "Relative frequency of synthetic scenes.");
 DEFINE_double(photo_weight, 1.0, "Relative frequency of moving photographs.");
 DEFINE_double(video_weight, 1.0, "Relative frequency of video files.");
 DEFINE_double(clip_weight, 1.0, "Relative frequency of frame folders.");
+DEFINE_double(realistic, 0.0,
+              "Share of samples, in [0, 1], recorded with a real sensor's effects (hot pixels, "
+              "leak, bandwidth, mains lamp, saturation, fixed-pattern and read noise).");
 DEFINE_bool(quiet, false, "Print only the final count.");
 
 namespace evfs {
@@ -81,6 +93,8 @@ constexpr double kPhotoRenderFps = 1000.0;
 // halved in size and read as 240 fps, their motion per frame is that of the 240 fps clips.
 constexpr double kVideoFps = 240.0;
 constexpr double kVideoScale = 0.5;
+// Added to a sample's seed for the realistic sensor's own random stream.
+constexpr uint64_t kRealisticSeedOffset = 0x5eed5eedULL;
 // Latent frames farther than this fraction of the source's frame period from a source frame
 // get no pair: between the frames of a clip the truth is only a linear interpolation.
 constexpr double kMaxTruthOffsetPeriods = 0.25;
@@ -94,6 +108,7 @@ struct PairGeneratorOptions {
   int threads = 1;
   std::vector<std::string> photos, videos, clips;
   double synthetic_weight = 1.0, photo_weight = 1.0, video_weight = 1.0, clip_weight = 1.0;
+  double realistic = 0.0;
 
   bool IsValid(std::string* error) const {
     OptionChecker check;
@@ -104,6 +119,7 @@ struct PairGeneratorOptions {
     check.Check(threads >= 1, "--threads must be >= 1");
     check.Check(synthetic_weight >= 0 && photo_weight >= 0 && video_weight >= 0 && clip_weight >= 0,
                 "source weights must be >= 0");
+    check.Check(realistic >= 0 && realistic <= 1, "--realistic must be in [0, 1]");
     const double total = synthetic_weight + (photos.empty() ? 0 : photo_weight) +
                          (videos.empty() ? 0 : video_weight) + (clips.empty() ? 0 : clip_weight);
     check.Check(total > 0, "no source: give a positive weight to a source that has files");
@@ -353,6 +369,44 @@ void WriteNpy(const std::string& path, const std::vector<const Image*>& channels
   if (!file) throw InputError(InputError::Kind::kUnwritable, path, 0, "a writable file");
 }
 
+/// A real sensor's effects drawn for one sample, around `evfs simulate`'s realistic variants
+/// (benchmarks/realistic_variants.sh): each effect on for about half the samples.
+struct RealisticSensor {
+  FlickerOptions lamp;
+  FrameEffectsOptions frames;
+};
+
+RealisticSensor DrawRealisticSensor(Random* random, SimulatorOptions* simulator,
+                                    std::ostream* config) {
+  RealisticSensor sensor;
+  if (random->Uniform() < 0.5) {
+    simulator->hot_pixel_fraction = random->Uniform(0.0005, 0.003);
+    simulator->hot_pixel_rate_hz = LogUniform(random, 30.0, 300.0);
+  }
+  if (random->Uniform() < 0.5) simulator->leak_rate_hz = LogUniform(random, 0.02, 0.5);
+  // A dim scene's photoreceptor bandwidth (a few hundred Hz); higher cutoffs follow the light
+  // nearly at once and only cost simulation sub-steps.
+  if (random->Uniform() < 0.3) simulator->cutoff_hz = LogUniform(random, 100.0, 500.0);
+  if (random->Uniform() < 0.15) {
+    sensor.lamp.mains_hz = random->Uniform() < 0.5 ? 100.0 : 120.0;
+    sensor.lamp.mains_depth = random->Uniform(0.05, 0.2);
+  }
+  if (random->Uniform() < 0.4) sensor.frames.gain = random->Uniform(1.0, 1.6);
+  sensor.frames.read_noise_dn = random->Uniform() < 0.3 ? 0.0 : random->Uniform(0.5, 3.0);
+  if (random->Uniform() < 0.6) {
+    sensor.frames.fpn_offset_dn = random->Uniform(0.2, 2.0);
+    sensor.frames.fpn_gain_sigma = random->Uniform(0.0, 0.015);
+  }
+  sensor.frames.seed = random->UniformIndex(1u << 30);
+  *config << "realistic hot=" << simulator->hot_pixel_fraction
+          << " leak_hz=" << simulator->leak_rate_hz << " cutoff_hz=" << simulator->cutoff_hz
+          << " mains_hz=" << sensor.lamp.mains_hz << ':' << sensor.lamp.mains_depth
+          << " gain=" << sensor.frames.gain << " read_dn=" << sensor.frames.read_noise_dn
+          << " fpn_dn=" << sensor.frames.fpn_offset_dn << ':' << sensor.frames.fpn_gain_sigma
+          << ' ';
+  return sensor;
+}
+
 class PairGenerator {
  public:
   explicit PairGenerator(const PairGeneratorOptions& options) : options_(options) {
@@ -417,7 +471,24 @@ class PairGenerator {
     simulator.refractory_period_ns =
         random.Uniform() < 0.7 ? 0 : static_cast<int64_t>(random.Uniform(0, 1e6));
     simulator.seed = random.UniformIndex(1u << 30);
-    const EventStream events = SimulateEvents(truth, simulator);
+    // The realistic sensor has its own random stream, so that samples without it are drawn as
+    // they are with --realistic=0.
+    Random sensor_random(options_.seed * 1000003ULL + static_cast<uint64_t>(index) +
+                         kRealisticSeedOffset);
+    const bool realistic = sensor_random.Uniform() < options_.realistic;
+    RealisticSensor sensor;
+    if (realistic) sensor = DrawRealisticSensor(&sensor_random, &simulator, &config);
+    const EventStream events = SimulateEvents(truth, simulator, sensor.lamp);
+    // What the camera sees at a time (the lamp's light included), what it records of that, and
+    // what the same sensor records without temporal read noise (the realistic pairs' truth).
+    const auto scene_at = [&](int64_t t_ns) { return SceneAt(truth, sensor.lamp, t_ns); };
+    std::unique_ptr<FrameReadout> readout, noiseless_readout;
+    if (realistic) {
+      readout = std::make_unique<FrameReadout>(truth.height(), truth.width(), sensor.frames);
+      FrameEffectsOptions noiseless = sensor.frames;
+      noiseless.read_noise_dn = 0.0;
+      noiseless_readout = std::make_unique<FrameReadout>(truth.height(), truth.width(), noiseless);
+    }
     config << "C+=" << simulator.contrast_threshold_pos
            << " C-=" << simulator.contrast_threshold_neg << " sigma=" << simulator.threshold_sigma
            << " noise_hz=" << simulator.noise_rate_hz
@@ -425,6 +496,9 @@ class PairGenerator {
 
     // The observed frames.
     const double noise_sigma = random.Uniform() < 0.6 ? 0.0 : random.Uniform(0.002, 0.015);
+    const auto record = [&](const Image& seen) {
+      return realistic ? readout->Read(seen) : Recorded(seen, noise_sigma, &random);
+    };
     const int last = truth.num_frames() - 1;
     const int64_t t_end = truth.timestamp_ns(last);
     BinningOptions binning;
@@ -447,17 +521,17 @@ class PairGenerator {
       if (deblur) {
         TimedFrame blurred;
         Image mean = Image::Zero(truth.height(), truth.width());
-        for (int t = 0; t <= last; ++t) mean += truth.frame(t);
-        blurred.image = Recorded(mean / (last + 1), noise_sigma, &random);
+        for (int t = 0; t <= last; ++t) mean += scene_at(truth.timestamp_ns(t));
+        blurred.image = record(mean / (last + 1));
         blurred.exposure_begin_ns = 0;
         blurred.exposure_end_ns = t_end;
         scene = MakeDeblurScene(blurred, events, binning);
       } else {
         TimedFrame first;
-        first.image = Recorded(truth.frame(0), noise_sigma, &random);
+        first.image = record(scene_at(truth.timestamp_ns(0)));
         if (interpolate) {
           TimedFrame end;
-          end.image = Recorded(truth.frame(last), noise_sigma, &random);
+          end.image = record(scene_at(t_end));
           end.exposure_begin_ns = end.exposure_end_ns = t_end;
           scene = MakeInterpolationScene(first, end, events, binning);
         } else {
@@ -528,7 +602,9 @@ class PairGenerator {
       const size_t pick = random.UniformIndex(candidates.size());
       const int k = candidates[pick];
       candidates.erase(candidates.begin() + pick);
-      const Image target = truth.InterpolateAt(latent.timestamp_ns(k));
+      const int64_t t_ns = latent.timestamp_ns(k);
+      const Image target =
+          realistic ? noiseless_readout->Read(scene_at(t_ns)) : truth.InterpolateAt(t_ns);
       const Image dmr = latent.frame(k);
       char name[64];
       std::snprintf(name, sizeof(name), "pair_%07d_%d.npy", index, written);
@@ -578,6 +654,7 @@ int Run() {
   options.photo_weight = FLAGS_photo_weight;
   options.video_weight = FLAGS_video_weight;
   options.clip_weight = FLAGS_clip_weight;
+  options.realistic = FLAGS_realistic;
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError(error);
 

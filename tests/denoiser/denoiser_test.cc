@@ -449,5 +449,56 @@ TEST(DenoiserTest, UnreadableWeightsAreUserErrors) {
   ExpectBadWeights(path, "cannot be read");
 }
 
+// The gate's weight σ²/(σ²+τ²) at σ = 1e6 τ differs from 1 by 1e-12; the correction between two
+// videos in [0, 1] is at most 1, so the gated value lies within that of the correction.
+constexpr double kLargeSigmaTolerance = 1e-11;
+
+TEST(GateCorrectionTest, ZeroSigmaKeepsTheInputBitForBit) {
+  const Video input = RandomVideo(9, 13, 3, 1);
+  const Video corrected = RandomVideo(9, 13, 3, 2);
+  const Video sigma(9, 13, 3);  // zero everywhere
+  const Video gated = GateCorrection(input, corrected, sigma, 0.01);
+  ASSERT_EQ(gated.num_frames(), input.num_frames());
+  EXPECT_EQ(0, std::memcmp(gated.data(), input.data(),
+                           sizeof(double) * input.pixels_per_frame() * input.num_frames()));
+}
+
+TEST(GateCorrectionTest, LargeSigmaTakesTheCorrection) {
+  const double tau = 0.02;
+  const Video input = RandomVideo(9, 13, 3, 3);
+  const Video corrected = RandomVideo(9, 13, 3, 4);
+  Video sigma(9, 13, 3);
+  for (int64_t i = 0; i < sigma.pixels_per_frame() * 3; ++i) sigma.data()[i] = 1e6 * tau;
+  const Video gated = GateCorrection(input, corrected, sigma, tau);
+  for (int64_t i = 0; i < input.pixels_per_frame() * 3; ++i) {
+    ASSERT_NEAR(gated.data()[i], corrected.data()[i], kLargeSigmaTolerance) << "value " << i;
+  }
+}
+
+TEST(GateCorrectionTest, WeightIsTheWienerGainPerPixel) {
+  const double tau = 0.05;
+  const Video input = RandomVideo(4, 5, 2, 5);
+  const Video corrected = RandomVideo(4, 5, 2, 6);
+  Video sigma = RandomVideo(4, 5, 2, 7);
+  sigma.data()[3] = tau;  // half the correction, by hand
+  const Video gated = GateCorrection(input, corrected, sigma, tau);
+  EXPECT_DOUBLE_EQ(gated.data()[3], 0.5 * (input.data()[3] + corrected.data()[3]));
+  for (int64_t i = 0; i < input.pixels_per_frame() * 2; ++i) {
+    const double s2 = sigma.data()[i] * sigma.data()[i];
+    const double expected =
+        input.data()[i] + s2 / (s2 + tau * tau) * (corrected.data()[i] - input.data()[i]);
+    EXPECT_DOUBLE_EQ(gated.data()[i], expected) << "value " << i;
+  }
+}
+
+TEST(GateCorrectionTest, BadTauOrSizesAreErrors) {
+  const Video video = RandomVideo(4, 5, 2, 8);
+  EXPECT_THROW(GateCorrection(video, video, video, 0.0), InvalidArgumentError);
+  EXPECT_THROW(GateCorrection(video, video, video, -1.0), InvalidArgumentError);
+  EXPECT_THROW(GateCorrection(video, video, video, std::nan("")), InvalidArgumentError);
+  EXPECT_THROW(GateCorrection(video, RandomVideo(4, 5, 3, 9), video, 0.1), InvalidArgumentError);
+  EXPECT_THROW(GateCorrection(video, video, RandomVideo(5, 4, 2, 9), 0.1), InvalidArgumentError);
+}
+
 }  // namespace
 }  // namespace evfs

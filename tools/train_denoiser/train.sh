@@ -6,6 +6,10 @@
 #
 # WORK_DIR (default BUILD_DIR/denoiser_training) receives the pairs and the logs. SAMPLES and
 # STEPS override the sample count and the optimiser steps (the shipped weights use the defaults).
+# REALISTIC (default 0) is the share of samples recorded with a real sensor's effects
+# (make_denoiser_pairs --realistic). ONNX, LOG and REFERENCE_DIR say where the network, its log
+# and the C++ test's reference pair go (default: models/ and tests/denoiser/data, the shipped
+# files); a candidate goes elsewhere until it meets models/README.md's acceptance.
 # Sources: synthetic scenes, photographs from opencv-doc and python3-skimage, the videos of
 # opencv-doc, and the three training clips of ../shared/data when it exists. The validation
 # recordings (adobe240_IMG_0004b, adobe240_IMG_0036, slider_depth_70_71, shapes_rotation_13_20,
@@ -18,6 +22,10 @@ repo=$(cd "$(dirname "$0")/../.." && pwd)
 samples=${SAMPLES:-400}
 steps=${STEPS:-12000}
 seed=${SEED:-17}
+realistic=${REALISTIC:-0}
+onnx=${ONNX:-$repo/models/evfs_denoiser.onnx}
+log=${LOG:-$repo/models/training_log.md}
+reference_dir=${REFERENCE_DIR:-$repo/tests/denoiser/data}
 
 opencv_data=/usr/share/doc/opencv-doc/examples/data
 skimage_data=/usr/lib/python3/dist-packages/skimage/data
@@ -47,15 +55,14 @@ echo "train-denoiser: ${#photos[@]} photographs, ${#videos[@]} videos, ${#clips[
 mkdir -p "$work_dir"
 start=$(date +%s)
 nice "$build_dir/tools/make_denoiser_pairs" --out="$work_dir/pairs" --overwrite \
-  --samples="$samples" --seed="$seed" --threads=1 --photos="$(join "${photos[@]}")" \
+  --samples="$samples" --seed="$seed" --threads=1 --realistic="$realistic" --photos="$(join "${photos[@]}")" \
   --videos="$(join "${videos[@]}")" --clips="$(join "${clips[@]}")" > "$work_dir/pairs.log"
 tail -1 "$work_dir/pairs.log"
 pairs_s=$(( $(date +%s) - start ))
 echo "train-denoiser: pairs made in $pairs_s s"
 
 nice /usr/bin/python3 "$repo/tools/train_denoiser/train.py" --pairs="$work_dir/pairs" \
-  --onnx="$repo/models/evfs_denoiser.onnx" --log="$repo/models/training_log.md" \
-  --reference_dir="$repo/tests/denoiser/data" --steps="$steps" --seed="$seed" --threads=2 \
+  --onnx="$onnx" --log="$log" --reference_dir="$reference_dir" --steps="$steps" --seed="$seed" --threads=2 \
   | tee "$work_dir/train.log"
 echo "train-denoiser: pairs $pairs_s s, all $(( $(date +%s) - start )) s" \
-  | tee -a "$repo/models/training_log.md"
+  | tee -a "$log"
