@@ -383,7 +383,9 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "Ceres linear solver: CGNR | SPARSE_NORMAL_CHOLESKY | ITERATIVE_SCHUR | DENSE_QR ...",
           Custom("reconstruct.method.reconstruction.solver.linear_solver_type", SetLinearSolver)),
       Row("preconditioner", "solver", "reconstruct video", kReconstructKey, Text("JACOBI"),
-          "Ceres preconditioner: JACOBI | IDENTITY | ...",
+          "Ceres preconditioner: JACOBI | IDENTITY | SUBSET (each pixel's temporal chain "
+          "factorised "
+          "exactly: fewer CG steps, dearer ones) | ...",
           Custom("reconstruct.method.reconstruction.solver.preconditioner_type",
                  SetPreconditioner)),
       Row("eta", "solver", "reconstruct video", kReconstructKey, Double(DefaultSolverOptions().eta),

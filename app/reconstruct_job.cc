@@ -335,6 +335,7 @@ void AddCeresLm(const ReconstructionOptions& options, const ReconstructionSummar
   };
   json["successful_steps"] = summary.ceres.num_successful_steps;
   json["unsuccessful_steps"] = summary.ceres.num_unsuccessful_steps;
+  json["linear_solver_iterations"] = summary.linear_solver_iterations;
 }
 
 Json ModelJson(const ObjectiveOptions& objective, const ReconstructionSummary& summary) {

@@ -438,6 +438,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["solved"] = run.solved;
   record["message"] = run.message;
   record["iterations"] = run.iterations;
+  record["linear_solver_iterations"] = run.reconstruction.linear_solver_iterations;
   if (!run.reconstruction.model.description.empty())
     record["model"] = run.reconstruction.model.description;
   record["initial_cost"] = Number(run.initial_cost);

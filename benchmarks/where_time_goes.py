@@ -2,7 +2,7 @@
 """Where the time of one evfs window goes, and how two builds compare (BENCHMARKS.md, "Where the
 time goes").
 
-    benchmarks/where_time_goes.py EVFS [EVFS_BEFORE] [--runs=N] [--data=DIR]
+    benchmarks/where_time_goes.py EVFS [EVFS_BEFORE] [--runs=N] [--data=DIR] [--flags="..."]
 
 Runs each case N times (default 5), alternating the two binaries when two are given, and prints
 one markdown table per binary of the medians of:
@@ -10,8 +10,11 @@ one markdown table per binary of the medians of:
   * start-up: `evfs --version`, CPU seconds;
   * the stages summary.json times (read, bin, build, solve, write) and, inside the solve, what
     Ceres reports (preprocessor, residual and Jacobian evaluation, linear solver);
-  * Ceres iterations and the PSNR of the withheld frame or frames;
-and, with two binaries, the ratios after / before of the pairs' CPU and wall seconds.
+  * Ceres iterations, conjugate-gradient steps (reconstruct) and the PSNR of the withheld frame
+    or frames;
+and, with two binaries, the ratios after / before of the pairs' CPU and wall seconds. --flags
+go to every job of EVFS; with one binary, EVFS with them is compared with EVFS without them
+(e.g. --flags=--preconditioner=SUBSET).
 
 The floor of a solve is its evaluations: every Levenberg-Marquardt iteration evaluates the
 residuals and the Jacobian at least once, so "evaluation" (Ceres' residual + Jacobian time) is
@@ -78,6 +81,7 @@ def stage_times(out, kind):
         figures["preprocessor"] = ceres["preprocessor"]
         figures["evaluation"] = ceres["residual_evaluation"] + ceres["jacobian_evaluation"]
         figures["linear solver"] = ceres["linear_solver"]
+        figures["CG steps"] = summary["solver"].get("linear_solver_iterations", float("nan"))
     return figures
 
 
@@ -92,30 +96,38 @@ def main():
     parser.add_argument("evfs")
     parser.add_argument("evfs_before", nargs="?")
     parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--flags", default="", help="extra evfs flags of EVFS's runs")
     parser.add_argument("--data", default=os.path.join(os.path.dirname(__file__),
                                                        "../../shared/data"))
     args = parser.parse_args()
-    binaries = [args.evfs] + ([args.evfs_before] if args.evfs_before else [])
+    flags = args.flags.split()
+    # (label, binary, extra flags) of each variant; the first is "after".
+    variants = [(" ".join([args.evfs] + flags), args.evfs, flags)]
+    if args.evfs_before:
+        variants.append((args.evfs_before, args.evfs_before, []))
+    elif flags:
+        variants.append((args.evfs, args.evfs, []))
+    binaries = [label for label, _, _ in variants]
     scratch = tempfile.mkdtemp(prefix="evfs-time-")
     results = {b: {} for b in binaries}  # binary -> case -> list of figure dicts
     try:
         for _ in range(args.runs):
-            for binary in binaries:
+            for label, binary, _ in variants:
                 _, cpu, _ = run([binary, "--version"])
-                results[binary].setdefault("start-up", []).append({"cpu": cpu})
+                results[label].setdefault("start-up", []).append({"cpu": cpu})
             for name, arguments, kind in cases(args.data):
-                for binary in binaries:
+                for label, binary, extra in variants:
                     out = os.path.join(scratch, "out")
-                    wall, cpu, output = run([binary] + arguments + [f"--out={out}"])
+                    wall, cpu, output = run([binary] + arguments + extra + [f"--out={out}"])
                     figures = stage_times(out, kind)
                     figures.update(wall=wall, cpu=cpu, psnr=psnr(output))
-                    results[binary].setdefault(name, []).append(figures)
+                    results[label].setdefault(name, []).append(figures)
                     shutil.rmtree(out)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
 
     columns = ["wall", "cpu", "read", "bin", "build", "solve", "preprocessor", "evaluation",
-               "linear solver", "write", "iterations", "psnr"]
+               "linear solver", "write", "iterations", "CG steps", "psnr"]
     for binary in binaries:
         print(f"\n{binary} (medians of {args.runs}; seconds, PSNR dB)\n")
         print("| job | " + " | ".join(columns) + " | floor share |")
@@ -123,7 +135,7 @@ def main():
         for name, runs in results[binary].items():
             cells = []
             for column in columns:
-                values = [r[column] for r in runs if column in r]
+                values = [r[column] for r in runs if column in r and r[column] == r[column]]
                 form = ".2f" if column == "psnr" else ".3g"
                 cells.append(f"{statistics.median(values):{form}}" if values else "")
             floor = [r["evaluation"] / (r["evaluation"] + r["linear solver"] + r["preprocessor"])

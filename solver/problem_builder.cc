@@ -278,6 +278,11 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
   ceres::Problem& problem = *built->problem_;
   ProblemStatistics& statistics = built->statistics_;
   CostFunctionCache cache(&built->cost_functions_);
+  // Each pixel's temporal chain, for Ceres' SUBSET preconditioner only.
+  const bool collect_temporal = options_.solver.preconditioner_type == ceres::SUBSET;
+  const auto temporal = [&](ceres::ResidualBlockId id) {
+    if (collect_temporal) built->temporal_residuals_.insert(id);
+  };
   LossCache losses(&built->losses_, objective.smoothing_scale);
 
   // The segments of pixel p are consecutive in the layout, from its first frame's.
@@ -333,7 +338,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
         const double value = frame.image.data()[p];
         ceres::CostFunction* cost = cache.Get(Family::kFrame, value, shape,
                                               [&] { return FrameResidual::Create(value, shape); });
-        problem.AddResidualBlock(cost, loss, blocks);
+        temporal(problem.AddResidualBlock(cost, loss, blocks));
         ++statistics.frame_residuals;
       }
     }
@@ -363,12 +368,12 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
           return EventResidual::Create(value, steps, objective.event_model);
         });
         if (steps == 1) {
-          problem.AddResidualBlock(cost, loss, block(span.latent_first, p),
-                                   block(span.latent_last, p));
+          temporal(problem.AddResidualBlock(cost, loss, block(span.latent_first, p),
+                                            block(span.latent_last, p)));
         } else {
           blocks.resize(steps + 1);
           for (int i = 0; i <= steps; ++i) blocks[i] = block(span.latent_first + i, p);
-          problem.AddResidualBlock(cost, loss, blocks);
+          temporal(problem.AddResidualBlock(cost, loss, blocks));
         }
         ++statistics.event_residuals;
       }
@@ -443,8 +448,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
             layout.segment(s + 1).pixel != p) {
           return;
         }
-        problem.AddResidualBlock(difference, loss, layout.value(s, latent),
-                                 layout.value(s + 1, latent));
+        temporal(problem.AddResidualBlock(difference, loss, layout.value(s, latent),
+                                          layout.value(s + 1, latent)));
         ++statistics.temporal_tv_residuals;
       });
     }
@@ -464,8 +469,8 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
         for (int t = segment.first; t <= segment.last; ++t) sum += target.frame_data(t)[p];
         const int length = segment.length();
         built->cost_functions_.emplace_back(PriorResidual::Create(sum / length, weight * length));
-        problem.AddResidualBlock(built->cost_functions_.back().get(), nullptr,
-                                 layout.value(s, latent));
+        temporal(problem.AddResidualBlock(built->cost_functions_.back().get(), nullptr,
+                                          layout.value(s, latent)));
         ++statistics.prior_residuals;
       });
     }

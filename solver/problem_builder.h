@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -56,9 +57,15 @@ class BuiltProblem {
   /// Which voxels the parameter blocks stand for (shared by every part of a scene); Expand()
   /// the latent video after a solve.
   const LatentLayout& layout() const { return *layout_; }
+  /// The residual blocks that couple one pixel's unknowns only (frame, event, temporal TV and
+  /// prior terms): each pixel's temporal chain, which Ceres' SUBSET preconditioner factorises.
+  const std::unordered_set<ceres::ResidualBlockId>& temporal_residuals() const {
+    return temporal_residuals_;
+  }
 
  private:
   friend class ProblemBuilder;
+  std::unordered_set<ceres::ResidualBlockId> temporal_residuals_;
   std::shared_ptr<const LatentLayout> layout_;
   std::vector<std::unique_ptr<ceres::CostFunction>> cost_functions_;
   std::vector<std::unique_ptr<ceres::LossFunction>> losses_;

@@ -9,6 +9,19 @@ namespace {
 
 bool IsNonNegativeFinite(double value) { return std::isfinite(value) && value >= 0.0; }
 
+// The SUBSET preconditioner's residual blocks are each problem's temporal chains
+// (BuiltProblem::temporal_residuals), known only once it is built: the other options are
+// checked with one stand-in block.
+ceres::Solver::Options SolverOptionsToCheck(const ceres::Solver::Options& solver) {
+  ceres::Solver::Options checked = solver;
+  if (checked.preconditioner_type == ceres::SUBSET) {
+    static int stand_in;
+    checked.residual_blocks_for_subset_preconditioner.insert(
+        reinterpret_cast<ceres::ResidualBlockId>(&stand_in));
+  }
+  return checked;
+}
+
 }  // namespace
 
 bool ObjectiveOptions::IsValid(std::string* error) const {
@@ -95,7 +108,7 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
       .Check(max_problem_mb <= kMaxProblemMb,
              "max_problem_mb must be at most " + std::to_string(kMaxProblemMb) + " (1 TiB)")
       .Check(solver.num_threads >= 1, "--threads must be 1 or more")
-      .Valid(solver);
+      .Valid(SolverOptionsToCheck(solver));
   return check.Passed(error);
 }
 

@@ -230,6 +230,9 @@ bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
     const auto part_options = [&](size_t i, int part_threads) {
       ceres::Solver::Options part = solve_options.solver;
       part.num_threads = part_threads;
+      if (part.preconditioner_type == ceres::SUBSET) {
+        part.residual_blocks_for_subset_preconditioner = parts[i]->temporal_residuals();
+      }
       if (stop.active()) {
         part.max_solver_time_in_seconds =
             std::min(part.max_solver_time_in_seconds, stop.SecondsLeft());
@@ -296,6 +299,9 @@ bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
     summary.solve_time_s += SecondsSince(solve_start) - time_in_callback_s;
     for (size_t i = 0; i < parts.size(); ++i) {
       Accumulate(part_summaries[i], &batch == &plan.batches().front() && i == 0, &summary.ceres);
+      for (const ceres::IterationSummary& step : part_summaries[i].iterations) {
+        summary.linear_solver_iterations += step.linear_solver_iterations;
+      }
       done_cost += part_summaries[i].final_cost;
       iterations = std::max(iterations, static_cast<int>(part_summaries[i].iterations.size()) - 1);
     }

@@ -33,6 +33,8 @@ struct ReconstructionSummary {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   int iterations = 0;  // of the part that took most
+  /// Linear solver (CG) iterations of every part and step together.
+  int64_t linear_solver_iterations = 0;
   /// Steps spread over a ramp (ReconstructionOptions::step_ramp_px).
   int64_t ramped_steps = 0;
 };
