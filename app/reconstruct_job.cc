@@ -518,8 +518,9 @@ void WriteReconstruction(const ReconstructRequest& request, ReconstructResult* r
                          const std::string& folder) {
   const auto write_start = Clock::now();
   const fs::path out(folder);
-  WriteFrameSequence(folder, result->output);
-  WriteImageSequence((out / "confidence").string(), result->confidence);
+  const int threads = request.method.reconstruction.solver.num_threads;
+  WriteFrameSequence(folder, result->output, threads);
+  WriteImageSequence((out / "confidence").string(), result->confidence, threads);
   result->time.write_s = SecondsSince(write_start);
   result->time.total_s += result->time.write_s;
   std::ofstream summary(out / "summary.json");

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/plugin.h"
 #include "io/decimal_seconds.h"
 #include "io/image_decoder_plugin.h"
@@ -246,7 +247,7 @@ void WriteTimestampsTxt(const std::string& path, const std::vector<int64_t>& t_n
   writer.Close();
 }
 
-void WriteImageSequence(const std::string& folder, const Video& video) {
+void WriteImageSequence(const std::string& folder, const Video& video, int threads) {
   const std::filesystem::path frames(folder);
   std::error_code error;
   std::filesystem::create_directories(frames, error);
@@ -254,15 +255,15 @@ void WriteImageSequence(const std::string& folder, const Video& video) {
     throw InputError(InputError::Kind::kUnwritable, frames.string(), 0,
                      "cannot create the folder (" + error.message() + ")");
   }
-  char name[32];
-  for (int t = 0; t < video.num_frames(); ++t) {
+  ParallelForEach(video.num_frames(), threads, [&](int t) {
+    char name[32];
     std::snprintf(name, sizeof(name), "%06d.png", t);
     WriteGreyPng16((frames / name).string(), video.frame(t));
-  }
+  });
 }
 
-void WriteFrameSequence(const std::string& folder, const Video& video) {
-  WriteImageSequence((std::filesystem::path(folder) / "frames").string(), video);
+void WriteFrameSequence(const std::string& folder, const Video& video, int threads) {
+  WriteImageSequence((std::filesystem::path(folder) / "frames").string(), video, threads);
   WriteTimestampsTxt((std::filesystem::path(folder) / "timestamps.txt").string(),
                      video.timestamps_ns());
 }

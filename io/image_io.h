@@ -49,13 +49,14 @@ void WriteGreyPngLossless(const std::string& path, const Image& image);
 void WriteTimestampsTxt(const std::string& path, const std::vector<int64_t>& t_ns);
 
 /// Writes every frame of `video` as `folder`/NNNNNN.png (16-bit, WriteGreyPng16; NNNNNN the
-/// 0-based frame index), creating the folder when missing. Throws InputError(kUnwritable).
-void WriteImageSequence(const std::string& folder, const Video& video);
+/// 0-based frame index), creating the folder when missing, the frames encoded on up to
+/// `threads` threads. Throws InputError(kUnwritable).
+void WriteImageSequence(const std::string& folder, const Video& video, int threads = 1);
 
 /// Writes `video` as a frame sequence in `folder` (created when missing): frames/NNNNNN.png
 /// (16-bit, WriteGreyPng16; NNNNNN the 0-based frame index) and timestamps.txt
-/// (WriteTimestampsTxt). Throws InputError(kUnwritable).
-void WriteFrameSequence(const std::string& folder, const Video& video);
+/// (WriteTimestampsTxt), on up to `threads` threads. Throws InputError(kUnwritable).
+void WriteFrameSequence(const std::string& folder, const Video& video, int threads = 1);
 
 }  // namespace evfs
 

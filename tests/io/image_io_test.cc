@@ -180,6 +180,29 @@ TEST(ImageIoTest, UnwritableImageIsAnInputError) {
                          InputError::Kind::kUnwritable, path, 0);
 }
 
+// Frames encoded on several threads are the files one thread writes, each under its index.
+TEST(ImageIoTest, ASequenceWrittenOnThreadsIsTheOneThreadsFiles) {
+  const std::string dir = test::ScratchDir("image_sequence_threads");
+  Video video;
+  for (int t = 0; t < 9; ++t) {
+    video.AppendFrame(test::MakeRandomImage(10 + t, kWidth, kHeight, 16), 1000 * t);
+  }
+  WriteFrameSequence(dir + "/one", video, 1);
+  WriteFrameSequence(dir + "/three", video, 3);
+  for (int t = 0; t < video.num_frames(); ++t) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "/frames/%06d.png", t);
+    const std::string one = test::ReadFile(dir + "/one" + name);
+    EXPECT_FALSE(one.empty()) << name;
+    EXPECT_EQ(test::ReadFile(dir + "/three" + name), one) << name;
+  }
+  EXPECT_EQ(test::ReadFile(dir + "/three/timestamps.txt"),
+            test::ReadFile(dir + "/one/timestamps.txt"));
+  // A folder that cannot be made is one error, naming it.
+  test::ExpectInputError([&] { WriteImageSequence(dir + "/one/timestamps.txt/x", video, 3); },
+                         InputError::Kind::kUnwritable, dir + "/one/timestamps.txt/x", 0);
+}
+
 TEST(ImageIoTest, TimestampsFileHasIndexAndNineDecimals) {
   const std::string path = test::ScratchDir("image_timestamps") + "/timestamps.txt";
   WriteTimestampsTxt(path, {2713576000, 2752341001});
