@@ -787,6 +787,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   for (const VideoWindow& window : windows) {
     if (records.count(window.index) == 0) pending.push_back(window.index);
   }
+  OrderLongestFirst(windows, &pending);
 
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const int threads_per_window =

@@ -169,6 +169,16 @@ int64_t OutputClock::TimeNs(int64_t n) const {
          static_cast<int64_t>(std::llround(static_cast<double>(n) * kNanosecondsPerSecond / fps_));
 }
 
+void OrderLongestFirst(const std::vector<VideoWindow>& windows, std::vector<int>* indices) {
+  const auto cost = [&windows](int index) {
+    const VideoWindow& window = windows[index];
+    return std::make_pair(window.end_ns - window.begin_ns,
+                          window.kind != VideoWindowKind::kInterpolate);
+  };
+  std::stable_sort(indices->begin(), indices->end(),
+                   [&cost](int a, int b) { return cost(a) > cost(b); });
+}
+
 int64_t OutputClock::FirstAtOrAfter(int64_t t_ns) const {
   if (t_ns <= t0_ns_) return 0;
   int64_t n = static_cast<int64_t>(

@@ -107,6 +107,12 @@ std::vector<int> SelectedFrames(int frame_count, const VideoWindowOptions& optio
 std::vector<VideoWindow> PlanVideoWindows(const std::vector<FrameInfo>& frames, bool has_events,
                                           int64_t last_event_ns, const VideoWindowOptions& options);
 
+/// Orders `indices` (of `windows`) longest first, so that a run does not end on one long window
+/// while the other jobs sit idle: a window's cost grows with its span, and a prediction or
+/// deblur, which no second frame pins, takes more iterations than an interpolation of the same
+/// span. Equal windows keep their order. The order changes no window's result.
+void OrderLongestFirst(const std::vector<VideoWindow>& windows, std::vector<int>* indices);
+
 /// The uniform output timeline: frame n at t0_ns + round(n · 1e9 / fps) nanoseconds.
 class OutputClock {
  public:

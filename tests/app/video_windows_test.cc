@@ -124,6 +124,20 @@ TEST(PlanVideoWindowsTest, FramesWithExposuresAreObservedOverThem) {
   EXPECT_FALSE(BlurCandidateExposure(Frames(1)[0], options, &begin_ns, &end_ns));
 }
 
+TEST(PlanVideoWindowsTest, LongestWindowsGoFirstAndPredictionsBeforeEqualInterpolations) {
+  std::vector<FrameInfo> frames = Frames(5);
+  frames[2].t_ns += 30 * kMs;  // gap 1 -> 2: 70 ms; 2 -> 3: 10 ms
+  // The tail prediction runs one median gap (40 ms), as long as the windows 0 and 3.
+  const std::vector<VideoWindow> windows =
+      PlanVideoWindows(frames, true, frames[4].t_ns + 100 * kMs, VideoWindowOptions());
+  ASSERT_EQ(windows.size(), 5u);
+  ASSERT_EQ(windows[4].kind, VideoWindowKind::kPredict);
+  ASSERT_EQ(windows[4].end_ns - windows[4].begin_ns, 40 * kMs);
+  std::vector<int> order = {0, 1, 2, 3, 4};
+  OrderLongestFirst(windows, &order);
+  EXPECT_EQ(order, (std::vector<int>{1, 4, 0, 3, 2}));
+}
+
 TEST(PlanVideoWindowsTest, SelectedFramesAreEveryStepFromFirstLessTheExcluded) {
   VideoWindowOptions options;
   options.first = 1;
