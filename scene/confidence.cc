@@ -256,16 +256,35 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
   return sigma;
 }
 
+double QuantisationStep(const Image& image) {
+  constexpr double kLevels = 255.0;
+  for (int64_t p = 0; p < image.size(); ++p) {
+    const double level = image.data()[p] * kLevels;
+    if (std::abs(level - std::round(level)) > 1e-6) return 0.0;
+  }
+  return 1.0 / kLevels;
+}
+
 double ShareWithinSigma(const Image& estimate, const Image& truth, const Image& sigma) {
   if (estimate.size() == 0 || estimate.rows() != truth.rows() || estimate.cols() != truth.cols() ||
       sigma.rows() != truth.rows() || sigma.cols() != truth.cols()) {
     throw InvalidArgumentError("ShareWithinSigma: the images must be non-empty and of one size");
   }
-  int64_t within = 0;
+  const double step = QuantisationStep(truth);
+  double within = 0.0;
   for (int64_t p = 0; p < estimate.size(); ++p) {
-    within += std::abs(estimate.data()[p] - truth.data()[p]) <= sigma.data()[p];
+    const double error = estimate.data()[p] - truth.data()[p];
+    const double band = sigma.data()[p];
+    if (step == 0.0) {
+      within += std::abs(error) <= band;
+    } else {
+      // The share of the bin [truth - step/2, truth + step/2] within band of the estimate.
+      const double low = std::max(error - band, -step / 2);
+      const double high = std::min(error + band, step / 2);
+      within += std::max(0.0, high - low) / step;
+    }
   }
-  return static_cast<double>(within) / static_cast<double>(estimate.size());
+  return within / static_cast<double>(estimate.size());
 }
 
 }  // namespace evfs

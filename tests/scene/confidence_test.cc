@@ -128,13 +128,30 @@ TEST(Confidence, FrameNoiseIsMeasuredWhereTheSceneHoldsStill) {
 }
 
 TEST(Confidence, ShareWithinSigmaCountsThePixelsInsideTheBand) {
-  const Image truth = Image::Constant(2, 2, 0.5);
+  const Image truth = Image::Constant(2, 2, 0.5);  // 127.5: not a whole 8-bit level
   Image estimate = truth;
   estimate(0, 0) = 0.6;   // error 0.1: outside a 0.05 band
   estimate(1, 1) = 0.53;  // error 0.03: inside
   EXPECT_DOUBLE_EQ(ShareWithinSigma(estimate, truth, Image::Constant(2, 2, 0.05)), 0.75);
   EXPECT_THROW(ShareWithinSigma(estimate, Image::Constant(3, 2, 0.5), Image::Constant(2, 2, 0.1)),
                InvalidArgumentError);
+}
+
+// An 8-bit truth gives the scene only to within half a level: a pixel counts with the share of
+// its level's bin within the band, so the count moves smoothly as the band widens.
+TEST(Confidence, ShareWithinSigmaOfAnEightBitTruthCountsTheShareOfItsBin) {
+  constexpr double kLevel = 1.0 / 255.0;
+  const Image truth = Image::Constant(1, 2, 128 * kLevel);
+  EXPECT_DOUBLE_EQ(QuantisationStep(truth), kLevel);
+  EXPECT_DOUBLE_EQ(QuantisationStep(Image::Constant(1, 2, 0.5)), 0.0);
+  Image estimate = truth;
+  estimate(0, 1) += kLevel;  // one level off
+  // A quarter-level band: the exact pixel keeps [−1/4, 1/4] of its bin [−1/2, 1/2] (half), the
+  // other pixel none.
+  EXPECT_NEAR(ShareWithinSigma(estimate, truth, Image::Constant(1, 2, kLevel / 4)), 0.25, 1e-12);
+  // One level: the exact pixel's whole bin, half of the other's.
+  EXPECT_NEAR(ShareWithinSigma(estimate, truth, Image::Constant(1, 2, kLevel)), 0.75, 1e-12);
+  // Counting |error| <= band would give 0.5 and 1.
 }
 
 TEST(Confidence, RejectsBadOptionsAndMismatchedVideos) {
