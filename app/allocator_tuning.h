@@ -19,10 +19,10 @@ namespace evfs {
 /// GLIBC_TUNABLES=glibc.malloc.hugetlb=1 does, which is read only from the environment at
 /// start-up): the Ceres problem's blocks and vectors then take 2 MB pages instead of 4 KB ones,
 /// 512 times fewer page faults and TLB entries. Whole `evfs reconstruct` on slider_depth took
-/// 0.79 times the time without it (BENCHMARKS.md, "Huge pages for the heap"). The growth is
-/// address space only; memory is used when touched. Later growth is glibc's usual, and under an
-/// address-space limit below 256 MB nothing grows ahead and nothing is advised. Where the kernel
-/// has no transparent huge pages (or they are off) the advice changes nothing.
+/// 0.79 times the time without it (benchmarks/results/speed_mechanisms.md, "Huge pages for the
+/// heap"). The growth is address space only; memory is used when touched. Later growth is glibc's
+/// usual, and under an address-space limit below 256 MB nothing grows ahead and nothing is advised.
+/// Where the kernel has no transparent huge pages (or they are off) the advice changes nothing.
 void KeepFreedMemoryForReuse();
 
 }  // namespace evfs

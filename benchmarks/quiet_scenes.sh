@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # PSNR of `evfs reconstruct` on the quiet windows and the moving windows that must
-# not get worse, one row per configuration (BENCHMARKS.md, "Quiet scenes").
+# not get worse, one row per configuration (benchmarks/results/model_choices.md, "Quiet scenes").
 #
 #   benchmarks/quiet_scenes.sh [BUILD_DIR] [SCRATCH_DIR] [DATA_DIR] -- LABEL [FLAGS...] [-- LABEL [FLAGS...]]...
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes a large synthetic ROS 1 bag for the memory figures of BENCHMARKS.md ("A large bag").
+"""Writes a large synthetic ROS 1 bag for the memory figures of BENCHMARKS.md ("A large ROS bag").
 
   write_large_rosbag.py OUT.bag [--frames N] [--events_per_frame N] [--compression none|lz4]
 

@@ -38,8 +38,8 @@ struct FrameLagOptions {
   /// shift, (r − r0) ≥ f · (1 − r0) with r0 the correlation at zero; otherwise the lag is 0: a
   /// flat correlation curve says little about timing. 0.025: the shapes_rotation 18, 20 pair
   /// peaks at +1.8 ms removing 1.9 % (and shifting by it costs 0.09 dB), while every simulated
-  /// window measured removes 3.2 % or more and gains 0.4 to 0.9 dB (BENCHMARKS.md, "Frame timing of
-  /// sharp frames").
+  /// window measured removes 3.2 % or more and gains 0.4 to 0.9 dB
+  /// (benchmarks/results/options_left_off.md, "Frame timing of sharp frames").
   double min_misfit_reduction = 0.025;
 
   bool IsValid(std::string* error) const;

@@ -13,7 +13,8 @@ namespace {
 constexpr uint8_t kContinues = 0, kStarts = 1, kStartsUnfiredChange = 2;
 
 // Fewest events at an unfired pixel's 8 neighbours after the last frame for it to change: one
-// event is as likely noise. Measured: BENCHMARKS.md, "Unfired pixels after the last frame".
+// event is as likely noise. Measured: benchmarks/results/model_choices.md, "Unfired pixels after
+// the last frame".
 constexpr float kMinNeighbourEvents = 2.0f;
 
 // The event frame at which each unfired active pixel changes (latent_layout.h), or -1: the

@@ -57,7 +57,8 @@ struct ObjectiveOptions {
   /// correlate positively (ObjectiveTerms::shared_structure_correlation), keep plain TV. On by
   /// default: with the step ramps it lifts every quiet window above the blend and
   /// event integration (GOPR9642 24, 28 → 26 by 1.1 dB) and no window the issue lists gets
-  /// worse (BENCHMARKS.md, "Spatial TV of what the frames do not share").
+  /// worse (benchmarks/results/model_choices.md, "Spatial TV of what the frames do not
+  /// share").
   bool shared_structure_tv = true;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
@@ -133,8 +134,9 @@ struct ReconstructionOptions {
   /// time-weighted blend of the two between them: no event says its change stayed below the
   /// threshold, and the blend meets both frames, where the solve holds such a pixel constant at
   /// a value the ℓ1 frame terms leave undecided. 0: off (the default: at 0.5 it passes more
-  /// quiet windows but costs two clips' interpolations 0.06 dB; sweep: BENCHMARKS.md, "Quiet
-  /// scenes"). Not applied with a prior (objective.prior_weight).
+  /// quiet windows but costs two clips' interpolations 0.06 dB; sweep:
+  /// benchmarks/results/model_choices.md, "Quiet scenes"). Not applied with a prior
+  /// (objective.prior_weight).
   double quiet_blend_fraction = 0.0;
   static constexpr double kMaxQuietBlendFraction = 100.0;
 
@@ -144,8 +146,9 @@ struct ReconstructionOptions {
   /// segment before, so that the sharp frames keep their values (solver/step_ramps.h). A pixel
   /// integrates light over its area, so an edge changes it over the time it takes to cross it,
   /// and a sensor fires when a change is complete; 2 allows a pixel of blur besides the pixel's
-  /// width (sweep: BENCHMARKS.md, "Steps as ramps"). Steps inside a blurred frame's exposure
-  /// stay jumps. 0: steps stay jumps. Not applied with a prior (objective.prior_weight).
+  /// width (sweep: benchmarks/results/model_choices.md, "Steps as ramps"). Steps inside a blurred
+  /// frame's exposure stay jumps. 0: steps stay jumps. Not applied with a prior
+  /// (objective.prior_weight).
   double step_ramp_px = 2.0;
   /// The last stage of a reconstruction, after any denoiser (app/method.h
   /// ApplySharpFrameSeams; Reconstruct() itself leaves the solve's answer): each sharp frame's

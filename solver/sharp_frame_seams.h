@@ -8,7 +8,8 @@
 // frames are exact. The latent frames next to a sharp frame inherit that offset. A video made of
 // consecutive windows, which shows each observed frame as it is, then jumps at every observed
 // frame, and the frames just after or before one are worse than event integration from it
-// (GOPR9642, one quarter of a gap from a frame: up to 2 dB, BENCHMARKS.md "Quiet scenes").
+// (GOPR9642, one quarter of a gap from a frame: up to 2 dB, benchmarks/results/model_choices.md,
+// "Quiet scenes").
 //
 // MeetSharpFrames() adds each sharp frame's offset δ = F − H(τ) to the latent frames around it,
 // with a weight of 1 at the frame that falls linearly in time to 0 half-way to the neighbouring

@@ -28,7 +28,7 @@
 // asks for the sharpest latent frames it allows: on the real eslnet_cups_blur recording even
 // ramps that kept every segment's mean (an earlier form, centred on the step) lowered the latent
 // frames' sharpness (variance of the Laplacian ×1e3, 6.94 → 5.73 at 2 px) at the same re-blur
-// PSNR (BENCHMARKS.md, "Steps as ramps").
+// PSNR (benchmarks/results/model_choices.md, "Steps as ramps").
 #ifndef EVFS_SOLVER_STEP_RAMPS_H_
 #define EVFS_SOLVER_STEP_RAMPS_H_
 
