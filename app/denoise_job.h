@@ -10,12 +10,12 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "app/frame_consistency.h"
 #include "app/method.h"
-#include "app/plug_and_play.h"
 #include "core/enum_names.h"
 #include "core/video.h"
 #include "denoiser/denoiser.h"
+#include "denoiser/frame_consistency.h"
+#include "plug_and_play/plug_and_play.h"
 #include "scene/scene.h"
 
 namespace evfs {

@@ -18,16 +18,16 @@
 #include <string_view>
 #include <thread>
 
-#include "app/frame_consistency.h"
 #include "app/run_report.h"
-#include "app/video_writer.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/option_checker.h"
 #include "core/parallel.h"
 #include "core/time.h"
+#include "denoiser/frame_consistency.h"
 #include "io/data_source.h"
 #include "io/image_io.h"
+#include "io/video_writer.h"
 #include "scene/confidence.h"
 #include "scene/scene.h"
 

@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "app/allocator_tuning.h"
 #include "app/method.h"
 #include "core/metrics.h"
 #include "events/scene_synthesizer.h"
 #include "events/simulator.h"
+#include "runtime/allocator_tuning.h"
 #include "solver/reconstructor.h"
 #include "solver/sharp_frame_seams.h"
 

@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/crash_guard.h"
+#include "runtime/crash_guard.h"
 
 namespace evfs {
 

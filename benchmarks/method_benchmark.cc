@@ -31,7 +31,6 @@
 #include <string>
 #include <vector>
 
-#include "app/allocator_tuning.h"
 #include "app/method.h"
 #include "app/reconstruct_job.h"
 #include "baselines/baseline.h"
@@ -41,6 +40,7 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/time.h"
+#include "runtime/allocator_tuning.h"
 #include "scene/scene.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");

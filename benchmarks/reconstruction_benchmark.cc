@@ -25,7 +25,6 @@
 #include <string>
 #include <vector>
 
-#include "app/allocator_tuning.h"
 #include "app/denoise_job.h"
 #include "app/reconstruct_job.h"
 #include "benchmarks/benchmark_cases.h"
@@ -33,6 +32,7 @@
 #include "core/metrics.h"
 #include "core/time.h"
 #include "events/simulator.h"
+#include "runtime/allocator_tuning.h"
 #include "solver/reconstructor.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");

@@ -20,7 +20,7 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "io/signal_cleanup.h"
+#include "runtime/signal_cleanup.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "app/crash_guard.h"
+#include "runtime/crash_guard.h"
 
 #include <glog/logging.h>
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 
 #include "core/error.h"
 #include "io/hdf5_io.h"
-#include "io/signal_cleanup.h"
+#include "runtime/signal_cleanup.h"
 #include "tests/test_data.h"
 
 namespace evfs {

@@ -1,4 +1,4 @@
-#include "app/frame_consistency.h"
+#include "denoiser/frame_consistency.h"
 
 #include <gtest/gtest.h>
 

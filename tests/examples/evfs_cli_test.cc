@@ -351,7 +351,7 @@ TEST(EvfsCli, Aedat31ReconstructsLikeItsFolderAndBadAedatIsAUserError) {
 
 // Two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation fault
 // (in H5AC_protect's block read, and in H5Aexists). The CLI runs HDF5 commands in a child
-// process (app/crash_guard.h), so they end as a user error, not as a crash. Whether libhdf5
+// process (runtime/crash_guard.h), so they end as a user error, not as a crash. Whether libhdf5
 // dies or reads garbage past the corruption depends on what its heap held (one CI run in many
 // read an exposure that ends before it starts instead): either way, one line naming the file.
 TEST(EvfsCli, Hdf5FileThatCrashesLibhdf5IsAUserError) {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "io/signal_cleanup.h"
+#include "runtime/signal_cleanup.h"
 #include "tests/io/io_test_util.h"
 #include "tests/test_data.h"
 

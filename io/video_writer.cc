@@ -1,4 +1,4 @@
-#include "app/video_writer.h"
+#include "io/video_writer.h"
 
 #include <stdlib.h>
 
@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "app/mp4_encoder_plugin.h"
 #include "core/error.h"
 #include "core/plugin.h"
+#include "io/mp4_encoder_plugin.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "app/plug_and_play.h"
+#include "plug_and_play/plug_and_play.h"
 
 #include <Eigen/Core>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "app/crash_guard.h"
+#include "runtime/crash_guard.h"
 
 #include <glog/logging.h>
 #include <sys/mman.h>
@@ -19,7 +19,7 @@
 
 #include "core/error.h"
 #include "core/input_library.h"
-#include "io/signal_cleanup.h"
+#include "runtime/signal_cleanup.h"
 
 namespace evfs {
 
