@@ -1,4 +1,4 @@
-#include "app/denoise_job.h"
+#include "evfs/app/denoise_job.h"
 
 #include <unistd.h>
 
@@ -9,13 +9,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "io/decimal_seconds.h"
-#include "io/image_io.h"
-#include "scene/activity_mask.h"
-#include "scene/confidence.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/io/decimal_seconds.h"
+#include "evfs/io/image_io.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/confidence.h"
 
 namespace evfs {
 namespace {

@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "app/method.h"
-#include "core/enum_names.h"
-#include "core/video.h"
-#include "denoiser/denoiser.h"
-#include "denoiser/frame_consistency.h"
-#include "plug_and_play/plug_and_play.h"
-#include "scene/scene.h"
+#include "evfs/app/method.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/video.h"
+#include "evfs/denoiser/denoiser.h"
+#include "evfs/denoiser/frame_consistency.h"
+#include "evfs/plug_and_play/plug_and_play.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

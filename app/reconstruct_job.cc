@@ -1,4 +1,4 @@
-#include "app/reconstruct_job.h"
+#include "evfs/app/reconstruct_job.h"
 
 #include <chrono>
 #include <cmath>
@@ -8,12 +8,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "app/frame_lag.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
+#include "evfs/app/frame_lag.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {

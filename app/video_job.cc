@@ -1,4 +1,4 @@
-#include "app/video_job.h"
+#include "evfs/app/video_job.h"
 
 #include <sys/resource.h>
 
@@ -18,18 +18,18 @@
 #include <string_view>
 #include <thread>
 
-#include "app/run_report.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/option_checker.h"
-#include "core/parallel.h"
-#include "core/time.h"
-#include "denoiser/frame_consistency.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
-#include "io/video_writer.h"
-#include "scene/confidence.h"
-#include "scene/scene.h"
+#include "evfs/app/run_report.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/parallel.h"
+#include "evfs/core/time.h"
+#include "evfs/denoiser/frame_consistency.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/video_writer.h"
+#include "evfs/scene/confidence.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 namespace {

@@ -37,15 +37,15 @@
 #include <string>
 #include <vector>
 
-#include "app/denoise_job.h"
-#include "app/method.h"
-#include "app/reconstruct_job.h"
-#include "benchmarks/benchmark_cases.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "denoiser/denoiser.h"
-#include "io/data_source.h"
-#include "plug_and_play/plug_and_play.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/method.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/benchmarks/benchmark_cases.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/denoiser/denoiser.h"
+#include "evfs/io/data_source.h"
+#include "evfs/plug_and_play/plug_and_play.h"
 
 DEFINE_string(weights, "", "The denoiser's ONNX file; empty: the shipped weights.");
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");

@@ -19,8 +19,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

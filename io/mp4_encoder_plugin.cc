@@ -1,5 +1,5 @@
 // The MP4 encoder plug-in (io/mp4_encoder_plugin.h): cv::VideoWriter behind a C interface.
-#include "io/mp4_encoder_plugin.h"
+#include "evfs/io/mp4_encoder_plugin.h"
 
 #include <malloc.h>
 #include <pthread.h>

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/signal_cleanup.h"
+#include "evfs/runtime/signal_cleanup.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "io/video_writer.h"
+#include "evfs/io/video_writer.h"
 
 #include <stdlib.h>
 
@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "core/plugin.h"
-#include "io/mp4_encoder_plugin.h"
+#include "evfs/core/error.h"
+#include "evfs/core/plugin.h"
+#include "evfs/io/mp4_encoder_plugin.h"
 
 namespace evfs {
 namespace {

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
-#include "denoiser/denoiser.h"
-#include "scene/scene.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/core/video.h"
+#include "evfs/denoiser/denoiser.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 

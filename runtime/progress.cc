@@ -1,4 +1,4 @@
-#include "runtime/progress.h"
+#include "evfs/runtime/progress.h"
 
 #include <cstdarg>
 #include <system_error>

@@ -19,7 +19,7 @@
 #include <string>
 #include <thread>
 
-#include "solver/iteration_callback.h"
+#include "evfs/solver/iteration_callback.h"
 
 namespace evfs {
 

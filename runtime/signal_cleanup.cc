@@ -1,4 +1,4 @@
-#include "runtime/signal_cleanup.h"
+#include "evfs/runtime/signal_cleanup.h"
 
 #include <fcntl.h>
 #include <unistd.h>

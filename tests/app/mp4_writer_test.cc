@@ -14,9 +14,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/video.h"
-#include "io/video_writer.h"
-#include "tests/test_data.h"
+#include "evfs/core/video.h"
+#include "evfs/io/video_writer.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "runtime/progress.h"
+#include "evfs/runtime/progress.h"
 
 #include <gtest/gtest.h>
 

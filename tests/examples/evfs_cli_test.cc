@@ -10,15 +10,15 @@
 #include <sstream>
 #include <string>
 
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "io/hdf5_io.h"
-#include "io/image_io.h"
-#include "io/text_folder.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/image_io.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {
