@@ -1,4 +1,4 @@
-// The C interface of the MP4 encoder plug-in (app/mp4_encoder_plugin.cc), a module that
+// The C interface of the MP4 encoder plug-in (io/mp4_encoder_plugin.cc), a module that
 // Mp4Writer opens with dlopen: OpenCV's videoio, with the FFmpeg and GStreamer libraries it
 // loads, then costs start-up time only to the commands that write MP4 files (BENCHMARKS.md,
 // "Start-up cost").
