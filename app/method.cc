@@ -152,6 +152,14 @@ bool MethodSupports(Method method, const Scene& scene, std::string* why_not) {
   return BaselineSupports(AsBaseline(method), scene, why_not);
 }
 
+void CheckMethodSupports(Method method, const Scene& scene, const std::string& what) {
+  std::string why_not;
+  if (!MethodSupports(method, scene, &why_not)) {
+    throw InvalidArgumentError(std::string("--solver=") + MethodName(method) +
+                               " cannot reconstruct " + what + ": " + why_not);
+  }
+}
+
 void CheckResampledOutputFits(double fps, double span_s, int width, int height,
                               const std::string& what) {
   constexpr double kBytesPerPixel = 2 * sizeof(double);  // a frame and its confidence map

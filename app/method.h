@@ -65,6 +65,9 @@ bool IsIterative(Method method);
 /// True when `method` can reconstruct `scene` (baselines support only some cases); otherwise
 /// false with the reason in `why_not` (may be null).
 bool MethodSupports(Method method, const Scene& scene, std::string* why_not);
+/// Throws InvalidArgumentError "--solver=NAME cannot reconstruct `what`: why" when `method`
+/// cannot reconstruct `scene` (MethodSupports).
+void CheckMethodSupports(Method method, const Scene& scene, const std::string& what);
 
 struct MethodOptions {
   Method method = Method::kCeresLm;

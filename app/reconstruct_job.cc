@@ -113,10 +113,8 @@ const char* ModeName(Mode mode) { return NameOf(kModeNames, mode); }
 
 namespace {
 
-// The job, reading `given` or, when it is null, the recording at request.data_path.
-ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
-                                        const DataSource* given) {
-  const auto total_start = Clock::now();
+// The request's options, checked before anything is read.
+void CheckRequest(const ReconstructRequest& request) {
   std::string error;
   if (!request.method.reconstruction.IsValid(&error)) {
     throw InvalidArgumentError("invalid options: " + error);
@@ -129,11 +127,157 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
     throw InvalidArgumentError("--exposure_s must be between 0 and " +
                                std::to_string(static_cast<int>(kMaxExposureS)) + " seconds");
   }
-
   CheckDenoiseMode(request.denoise.mode, request.method.method);
   if (request.denoise.mode == DenoiseMode::kPnp && !request.denoise.pnp.IsValid(&error)) {
     throw InvalidArgumentError("invalid plug & play options: " + error);
   }
+}
+
+// The frames a request names, checked against the recording; returns the last frame (--last,
+// or the one after --first).
+int CheckWindowFrames(const DataSource& source, const ReconstructRequest& request) {
+  CheckWholeTextRecording(source);
+  // From the declared size, before a frame is decoded: a large declared sensor with small
+  // compressed frames would otherwise cost its full size in memory first.
+  CheckSensorFitsLatentVoxels(source.width(), source.height(), request.binning);
+  CheckFrameIndex(source, request.first, "the first");
+  const int last = request.last >= 0 ? request.last : request.first + 1;
+  if (request.mode != Mode::kDeblur) {
+    CheckFrameIndex(source, last, "the last");
+    if (last <= request.first) {
+      throw InvalidArgumentError("--last (" + std::to_string(last) + ") must come after --first (" +
+                                 std::to_string(request.first) + ")");
+    }
+  }
+  if (request.truth >= 0) CheckFrameIndex(source, request.truth, "the truth");
+  return last;
+}
+
+// The moment each sharp frame represents. Auto estimates the lag from the input frames only
+// (interpolate: the two; predict: the first and the one before it), never from the truth.
+SharpFrameTiming ResolveFrameTiming(const DataSource& source, const ReconstructRequest& request,
+                                    int last, FrameLagEstimate* lag) {
+  SharpFrameTiming timing{request.frame_time, SecondsToNanoseconds(request.frame_lag_s),
+                          SecondsToNanoseconds(request.exposure_s)};
+  if (request.mode != Mode::kDeblur && request.frame_time == FrameTime::kAuto) {
+    std::vector<int> inputs = {request.first, last};
+    if (request.mode == Mode::kPredict) inputs = {request.first - 1, request.first};
+    if (inputs.front() < 0 || inputs.front() == request.truth) inputs = {};
+    *lag = EstimateRecordingFrameLag(source, inputs, request.frame_lag);
+    timing.lag_ns = lag->lag_ns;
+  }
+  return timing;
+}
+
+// What the window's scene is made of, read from the recording.
+struct WindowInputs {
+  std::vector<TimedFrame> frames;
+  int64_t begin_ns = 0;
+  int64_t end_ns = 0;
+  EventStream events;
+};
+
+// The observed frames of the request's mode, the window they span and its events. Checks that
+// --fps can resample the window.
+WindowInputs ReadWindowInputs(const DataSource& source, const ReconstructRequest& request, int last,
+                              const SharpFrameTiming& timing) {
+  WindowInputs inputs;
+  switch (request.mode) {
+    case Mode::kInterpolate:
+      inputs.frames = {ReadSharpFrame(source, request.first, timing),
+                       ReadSharpFrame(source, last, timing)};
+      inputs.begin_ns = inputs.frames.front().exposure_begin_ns;
+      inputs.end_ns = inputs.frames.back().exposure_end_ns;
+      break;
+    case Mode::kPredict:
+      inputs.frames = {ReadSharpFrame(source, request.first, timing)};
+      inputs.begin_ns = inputs.frames.front().exposure_begin_ns;
+      inputs.end_ns = SharpFrameSpan(source, last, timing).middle_ns();
+      break;
+    case Mode::kDeblur:
+      inputs.frames = {ReadBlurredFrame(source, request.first, request.exposure_s)};
+      inputs.begin_ns = inputs.frames.front().exposure_begin_ns;
+      inputs.end_ns = inputs.frames.front().exposure_end_ns;
+      break;
+  }
+  const double window_s = NanosecondsToSeconds(inputs.end_ns - inputs.begin_ns);
+  if (request.fps * window_s > kMaxOutputFrames) {
+    throw InvalidArgumentError("--fps would resample the " + std::to_string(window_s) +
+                               " s window to more than " +
+                               std::to_string(static_cast<int>(kMaxOutputFrames)) + " frames");
+  }
+  if (request.fps > 0.0) {
+    CheckResampledOutputFits(request.fps, window_s, source.width(), source.height(), "window");
+  }
+  inputs.events = source.ReadEvents(inputs.begin_ns, inputs.end_ns);
+  return inputs;
+}
+
+// The scene's counts of events and of the pixels whose events were left out.
+void CountSceneEvents(const Scene& scene, ReconstructResult* result) {
+  result->events = scene.num_events;
+  result->event_frames = scene.events.num_frames();
+  result->hot_pixels = static_cast<int>(scene.hot_pixels.size());
+  result->hot_pixel_events = scene.hot_pixel_events;
+  result->noise_events = scene.noise_events;
+  result->saturated_pixels = static_cast<int>(scene.saturated_pixels.size());
+  result->saturated_pixel_events = scene.saturated_pixel_events;
+  result->flickering_pixels = static_cast<int>(scene.flickering_pixels.size());
+  result->flickering_pixel_events = scene.flickering_pixel_events;
+}
+
+// The moment the truth frame represents, as for the inputs (deblur: its timestamp); throws
+// when it lies outside the window.
+int64_t TruthTimestamp(const DataSource& source, const ReconstructRequest& request,
+                       const SharpFrameTiming& timing, const WindowInputs& inputs) {
+  const int64_t t_ns = request.mode == Mode::kDeblur
+                           ? source.frames()[request.truth].t_ns
+                           : SharpFrameSpan(source, request.truth, timing).middle_ns();
+  if (t_ns < inputs.begin_ns || t_ns > inputs.end_ns) {
+    throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
+                               " lies outside the reconstructed window");
+  }
+  return t_ns;
+}
+
+// The denoiser on the solved latent video (plug & play, or once, gated), scored against the
+// truth when there is one.
+DenoiseRecord DenoiseSolution(const Denoiser& denoiser, const DenoiseRequest& request,
+                              const Scene& scene, const MethodOptions& method,
+                              const MethodOptions& clocked, const Image* truth,
+                              int64_t truth_timestamp_ns, MethodResult* run) {
+  const int truth_latent = truth != nullptr ? run->video.NearestFrame(truth_timestamp_ns) : -1;
+  const DenoiseRegion region = SolvedRegion(scene, method, run->solved);
+  if (request.mode == DenoiseMode::kPnp) {
+    return PlugAndPlayLatentVideo(denoiser, scene, clocked, request.pnp, region, truth,
+                                  truth_latent, run);
+  }
+  const std::unique_ptr<DenoiseGate> gate = MakeDenoiseGate(request, scene, method, *run);
+  return DenoiseLatentVideo(denoiser, request.mode, region, request.consistency ? &scene : nullptr,
+                            truth, truth_latent, &run->video, gate.get());
+}
+
+// The latent frame nearest the truth against it, beside the baseline's, and the share of its
+// pixels within the predicted error.
+void ScoreTruth(const Video& latent, const Video& baseline, const Video& sigma,
+                const Image& truth_image, TruthScore* truth, double* within_sigma) {
+  truth->image = truth_image;
+  truth->latent_index = latent.NearestFrame(truth->timestamp_ns);
+  const Image estimate = latent.frame(truth->latent_index);
+  truth->psnr = Psnr(estimate, truth_image);
+  truth->ssim = Ssim(estimate, truth_image);
+  const Image blend = baseline.frame(truth->latent_index);
+  truth->baseline_psnr = Psnr(blend, truth_image);
+  truth->baseline_ssim = Ssim(blend, truth_image);
+  *within_sigma = ShareWithinSigma(estimate, truth_image, sigma.frame(truth->latent_index));
+}
+
+// The job, reading `given` or, when it is null, the recording at request.data_path: read →
+// frame timing → scene → solve → denoise → seams → output and confidence → score.
+ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
+                                        const DataSource* given) {
+  const auto total_start = Clock::now();
+  CheckRequest(request);
   // Loaded before any input is read: a bad weights file fails in milliseconds, not after a solve.
   const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request.denoise);
 
@@ -146,108 +290,36 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   const auto read_start = Clock::now();
   std::unique_ptr<DataSource> opened;
   if (given == nullptr) opened = DataSource::Open(request.data_path, request.data_options);
-  const DataSource* source = given != nullptr ? given : opened.get();
-  CheckWholeTextRecording(*source);
-  result.width = source->width();
-  result.height = source->height();
-  // From the declared size, before a frame is decoded: a large declared sensor with small
-  // compressed frames would otherwise cost its full size in memory first.
-  CheckSensorFitsLatentVoxels(result.width, result.height, request.binning);
-  CheckFrameIndex(*source, request.first, "the first");
-  const int last = request.last >= 0 ? request.last : request.first + 1;
+  const DataSource& source = given != nullptr ? *given : *opened;
+  result.width = source.width();
+  result.height = source.height();
+  const int last = CheckWindowFrames(source, request);
+  const SharpFrameTiming timing = ResolveFrameTiming(source, request, last, &result.frame_lag);
   if (request.mode != Mode::kDeblur) {
-    CheckFrameIndex(*source, last, "the last");
-    if (last <= request.first) {
-      throw InvalidArgumentError("--last (" + std::to_string(last) + ") must come after --first (" +
-                                 std::to_string(request.first) + ")");
-    }
+    result.frame_shift_ns = SharpFrameSpan(source, request.first, timing).middle_ns() -
+                            source.frames()[request.first].t_ns;
   }
-  if (request.truth >= 0) CheckFrameIndex(*source, request.truth, "the truth");
-
-  // The moment each sharp frame represents. Auto estimates the lag from the input frames only
-  // (interpolate: the two; predict: the first and the one before it), never from the truth.
-  SharpFrameTiming timing{request.frame_time, SecondsToNanoseconds(request.frame_lag_s),
-                          SecondsToNanoseconds(request.exposure_s)};
-  if (request.mode != Mode::kDeblur && request.frame_time == FrameTime::kAuto) {
-    std::vector<int> inputs = {request.first, last};
-    if (request.mode == Mode::kPredict) inputs = {request.first - 1, request.first};
-    if (inputs.front() < 0 || inputs.front() == request.truth) inputs = {};
-    result.frame_lag = EstimateRecordingFrameLag(*source, inputs, request.frame_lag);
-    timing.lag_ns = result.frame_lag.lag_ns;
-  }
-  if (request.mode != Mode::kDeblur) {
-    result.frame_shift_ns = SharpFrameSpan(*source, request.first, timing).middle_ns() -
-                            source->frames()[request.first].t_ns;
-  }
-
-  std::vector<TimedFrame> frames;
-  int64_t window_begin_ns = 0, window_end_ns = 0;
-  switch (request.mode) {
-    case Mode::kInterpolate:
-      frames = {ReadSharpFrame(*source, request.first, timing),
-                ReadSharpFrame(*source, last, timing)};
-      window_begin_ns = frames.front().exposure_begin_ns;
-      window_end_ns = frames.back().exposure_end_ns;
-      break;
-    case Mode::kPredict:
-      frames = {ReadSharpFrame(*source, request.first, timing)};
-      window_begin_ns = frames.front().exposure_begin_ns;
-      window_end_ns = SharpFrameSpan(*source, last, timing).middle_ns();
-      break;
-    case Mode::kDeblur:
-      frames = {ReadBlurredFrame(*source, request.first, request.exposure_s)};
-      window_begin_ns = frames.front().exposure_begin_ns;
-      window_end_ns = frames.front().exposure_end_ns;
-      break;
-  }
-  const double window_s = NanosecondsToSeconds(window_end_ns - window_begin_ns);
-  if (request.fps * window_s > kMaxOutputFrames) {
-    throw InvalidArgumentError("--fps would resample the " + std::to_string(window_s) +
-                               " s window to more than " +
-                               std::to_string(static_cast<int>(kMaxOutputFrames)) + " frames");
-  }
-  if (request.fps > 0.0) {
-    CheckResampledOutputFits(request.fps, window_s, source->width(), source->height(), "window");
-  }
-  const EventStream events = source->ReadEvents(window_begin_ns, window_end_ns);
+  const WindowInputs inputs = ReadWindowInputs(source, request, last, timing);
+  const bool score = request.truth >= 0;
   Image truth_image;
-  if (request.truth >= 0) truth_image = source->ReadImage(request.truth);
+  if (score) truth_image = source.ReadImage(request.truth);
   result.time.read_s = SecondsSince(read_start);
 
   stage("bin");
   const auto bin_start = Clock::now();
-  const Scene scene = MakeScene(frames, events, window_begin_ns, window_end_ns, request.binning);
-  result.events = scene.num_events;
-  result.event_frames = scene.events.num_frames();
-  result.hot_pixels = static_cast<int>(scene.hot_pixels.size());
-  result.hot_pixel_events = scene.hot_pixel_events;
-  result.noise_events = scene.noise_events;
-  result.saturated_pixels = static_cast<int>(scene.saturated_pixels.size());
-  result.saturated_pixel_events = scene.saturated_pixel_events;
-  result.flickering_pixels = static_cast<int>(scene.flickering_pixels.size());
-  result.flickering_pixel_events = scene.flickering_pixel_events;
+  const Scene scene =
+      MakeScene(inputs.frames, inputs.events, inputs.begin_ns, inputs.end_ns, request.binning);
+  CountSceneEvents(scene, &result);
   result.time.bin_s = SecondsSince(bin_start);
 
   result.baseline = InitializeLatentVideo(scene);
   CheckpointTruth checkpoint_truth;
-  const bool score = request.truth >= 0;
   if (score) {
-    // The moment the truth frame represents, as for the inputs (deblur: its timestamp).
-    result.truth.timestamp_ns = request.mode == Mode::kDeblur
-                                    ? source->frames()[request.truth].t_ns
-                                    : SharpFrameSpan(*source, request.truth, timing).middle_ns();
-    if (result.truth.timestamp_ns < window_begin_ns || result.truth.timestamp_ns > window_end_ns) {
-      throw InvalidArgumentError("--truth frame " + std::to_string(request.truth) +
-                                 " lies outside the reconstructed window");
-    }
+    result.truth.timestamp_ns = TruthTimestamp(source, request, timing, inputs);
     checkpoint_truth.image = &truth_image;
     checkpoint_truth.latent_index = result.baseline.NearestFrame(result.truth.timestamp_ns);
   }
-  std::string why_not;
-  if (!MethodSupports(request.method.method, scene, &why_not)) {
-    throw InvalidArgumentError(std::string("--solver=") + MethodName(request.method.method) +
-                               " cannot reconstruct this case: " + why_not);
-  }
+  CheckMethodSupports(request.method.method, scene, "this case");
   stage(request.progress ? "build" : "build and solve");
   MethodOptions method = request.method;
   StartSolveClock(&method);
@@ -257,40 +329,21 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   result.time.solve_s = result.run.solve_time_s;
   if (denoiser != nullptr) {
     stage("denoise");
-    const int truth_latent = score ? result.run.video.NearestFrame(result.truth.timestamp_ns) : -1;
-    const DenoiseRegion region = SolvedRegion(scene, request.method, result.run.solved);
-    const Image* truth = score ? &truth_image : nullptr;
-    if (request.denoise.mode == DenoiseMode::kPnp) {
-      result.denoise = PlugAndPlayLatentVideo(*denoiser, scene, method, request.denoise.pnp, region,
-                                              truth, truth_latent, &result.run);
-    } else {
-      const std::unique_ptr<DenoiseGate> gate =
-          MakeDenoiseGate(request.denoise, scene, request.method, result.run);
-      result.denoise = DenoiseLatentVideo(*denoiser, request.denoise.mode, region,
-                                          request.denoise.consistency ? &scene : nullptr, truth,
-                                          truth_latent, &result.run.video, gate.get());
-    }
+    result.denoise =
+        DenoiseSolution(*denoiser, request.denoise, scene, request.method, method,
+                        score ? &truth_image : nullptr, result.truth.timestamp_ns, &result.run);
   }
   ApplySharpFrameSeams(scene, request.method, &result.run);
+
   const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
   const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(request.method, result.run),
                                         &result.confidence_model);
   result.confidence = request.fps > 0.0 ? Resample(sigma, request.fps) : sigma;
-
-  if (request.truth >= 0) {
-    TruthScore& truth = result.truth;
-    truth.index = request.truth;
-    truth.image = truth_image;
-    truth.latent_index = latent.NearestFrame(truth.timestamp_ns);
-    const Image estimate = latent.frame(truth.latent_index);
-    truth.psnr = Psnr(estimate, truth_image);
-    truth.ssim = Ssim(estimate, truth_image);
-    const Image baseline = result.baseline.frame(truth.latent_index);
-    truth.baseline_psnr = Psnr(baseline, truth_image);
-    truth.baseline_ssim = Ssim(baseline, truth_image);
-    result.truth_within_sigma =
-        ShareWithinSigma(estimate, truth_image, sigma.frame(truth.latent_index));
+  if (score) {
+    result.truth.index = request.truth;
+    ScoreTruth(latent, result.baseline, sigma, truth_image, &result.truth,
+               &result.truth_within_sigma);
     result.has_truth = true;
   }
   result.time.total_s = SecondsSince(total_start);

@@ -358,12 +358,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   const auto bin_start = Clock::now();
   const Scene scene = MakeScene(frames, events, window.begin_ns, window.end_ns, request.binning);
   const double bin_s = SecondsSince(bin_start);
-  std::string why_not;
-  if (!MethodSupports(context.method.method, scene, &why_not)) {
-    throw InvalidArgumentError(std::string("--solver=") + MethodName(context.method.method) +
-                               " cannot reconstruct window " + std::to_string(window.index) + ": " +
-                               why_not);
-  }
+  CheckMethodSupports(context.method.method, scene, "window " + std::to_string(window.index));
   MethodOptions method = context.method;  // --max_time_s bounds each window's solve
   StartSolveClock(&method);
   MethodResult run = RunMethod(scene, method, IterationCallback(), false, nullptr);

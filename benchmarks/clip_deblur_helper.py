@@ -8,9 +8,9 @@ only.
   clip_deblur_helper.py score SIMULATION RECONSTRUCTION NUM_FRAMES
       Mean PSNR (dB) of the reconstruction's frames nearest each of those frames' timestamps.
 """
-import math, os, shutil, sys
+import os, shutil, sys
 
-from realistic_variants_helper import read_png, write_png
+from realistic_variants_helper import psnr, read_png, write_png
 
 def frame_list(folder, num_frames):
     lines = [l.split() for l in open(os.path.join(folder, "images.txt"))
@@ -40,9 +40,7 @@ def score(simulation, reconstruction, num_frames):
     for t, path in frame_list(simulation, num_frames):
         nearest = min(range(len(times)), key=lambda k: abs(times[k] - float(t)))
         estimate = read_png(os.path.join(reconstruction, "frames", outputs[nearest]))
-        truth = read_png(path)
-        error = sum((a - b) ** 2 for ra, rb in zip(estimate, truth) for a, b in zip(ra, rb))
-        total += 10 * math.log10(len(truth) * len(truth[0]) / max(error, 1e-20))
+        total += psnr(estimate, read_png(path), lambda x, y: True)
     print("%.2f" % (total / num_frames))
 
 if __name__ == "__main__":
