@@ -198,6 +198,23 @@ DenoiseRecord PlugAndPlayLatentVideo(const Denoiser& denoiser, const Scene& scen
   return record;
 }
 
+DenoiseRecord DenoiseSolution(const Denoiser& denoiser, const DenoiseRequest& request,
+                              const Scene& scene, const MethodOptions& method,
+                              const MethodOptions& clocked, const Image* truth,
+                              int64_t truth_timestamp_ns, const std::vector<uint8_t>* only_frames,
+                              MethodResult* run) {
+  const int truth_latent = truth != nullptr ? run->video.NearestFrame(truth_timestamp_ns) : -1;
+  DenoiseRegion region = SolvedRegion(scene, method, run->solved);
+  if (only_frames != nullptr) region.frames = *only_frames;
+  if (request.mode == DenoiseMode::kPnp) {
+    return PlugAndPlayLatentVideo(denoiser, scene, clocked, request.pnp, region, truth,
+                                  truth_latent, run);
+  }
+  const std::unique_ptr<DenoiseGate> gate = MakeDenoiseGate(request, scene, method, *run);
+  return DenoiseLatentVideo(denoiser, request.mode, region, request.consistency ? &scene : nullptr,
+                            truth, truth_latent, &run->video, gate.get());
+}
+
 Json DenoiseJson(const DenoiseRecord& record) {
   Json json;
   json["mode"] = NameOf(kDenoiseModeNames, record.mode);
