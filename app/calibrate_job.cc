@@ -1,4 +1,4 @@
-#include "app/calibrate_job.h"
+#include "evfs/app/calibrate_job.h"
 
 #include <algorithm>
 #include <chrono>
@@ -7,10 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "app/frame_lag.h"
-#include "core/error.h"
-#include "core/time.h"
-#include "io/data_source.h"
+#include "evfs/app/frame_lag.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 namespace {

@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <string>
 
-#include "io/data_source.h"
-#include "scene/event_model.h"
-#include "scene/event_model_estimation.h"
-#include "scene/frame_timing.h"
-#include "solver/event_model_calibration.h"
+#include "evfs/io/data_source.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/scene/frame_timing.h"
+#include "evfs/solver/event_model_calibration.h"
 
 namespace evfs {
 

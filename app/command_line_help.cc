@@ -1,4 +1,4 @@
-#include "app/command_line_help.h"
+#include "evfs/app/command_line_help.h"
 
 #include <gflags/gflags.h>
 
@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -1,19 +1,19 @@
-#include "app/demo.h"
+#include "evfs/app/demo.h"
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <vector>
 
-#include "app/denoise_job.h"
-#include "app/reconstruct_job.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "io/text_folder.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/text_folder.h"
 
 namespace evfs {
 namespace {

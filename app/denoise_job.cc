@@ -1,4 +1,4 @@
-#include "app/denoise_job.h"
+#include "evfs/app/denoise_job.h"
 
 #include <unistd.h>
 
@@ -9,13 +9,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "io/decimal_seconds.h"
-#include "io/image_io.h"
-#include "scene/activity_mask.h"
-#include "scene/confidence.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/io/decimal_seconds.h"
+#include "evfs/io/image_io.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/confidence.h"
 
 namespace evfs {
 namespace {
@@ -196,6 +196,23 @@ DenoiseRecord PlugAndPlayLatentVideo(const Denoiser& denoiser, const Scene& scen
   options.objective.event_model.off_alpha_ratio = solved->reconstruction.model.off_alpha_ratio;
   latent = PlugAndPlay(scene, options, denoiser, region, latent, pnp, &record.pnp, &record.stats);
   return record;
+}
+
+DenoiseRecord DenoiseSolution(const Denoiser& denoiser, const DenoiseRequest& request,
+                              const Scene& scene, const MethodOptions& method,
+                              const MethodOptions& clocked, const Image* truth,
+                              int64_t truth_timestamp_ns, const std::vector<uint8_t>* only_frames,
+                              MethodResult* run) {
+  const int truth_latent = truth != nullptr ? run->video.NearestFrame(truth_timestamp_ns) : -1;
+  DenoiseRegion region = SolvedRegion(scene, method, run->solved);
+  if (only_frames != nullptr) region.frames = *only_frames;
+  if (request.mode == DenoiseMode::kPnp) {
+    return PlugAndPlayLatentVideo(denoiser, scene, clocked, request.pnp, region, truth,
+                                  truth_latent, run);
+  }
+  const std::unique_ptr<DenoiseGate> gate = MakeDenoiseGate(request, scene, method, *run);
+  return DenoiseLatentVideo(denoiser, request.mode, region, request.consistency ? &scene : nullptr,
+                            truth, truth_latent, &run->video, gate.get());
 }
 
 Json DenoiseJson(const DenoiseRecord& record) {

@@ -9,14 +9,15 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
-#include "app/frame_consistency.h"
-#include "app/method.h"
-#include "app/plug_and_play.h"
-#include "core/enum_names.h"
-#include "core/video.h"
-#include "denoiser/denoiser.h"
-#include "scene/scene.h"
+#include "evfs/app/method.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/video.h"
+#include "evfs/denoiser/denoiser.h"
+#include "evfs/denoiser/frame_consistency.h"
+#include "evfs/plug_and_play/plug_and_play.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 
@@ -133,6 +134,17 @@ DenoiseRecord PlugAndPlayLatentVideo(const Denoiser& denoiser, const Scene& scen
                                      const MethodOptions& method, const PlugAndPlayOptions& pnp,
                                      const DenoiseRegion& region, const Image* truth,
                                      int truth_index, MethodResult* solved);
+
+/// The denoising stage of a job: `denoiser` on the latent video of `run` (the solve of `scene`
+/// by `method`; `clocked` is `method` with its time budget started, for plug & play's solves)
+/// as `request` asks: plug & play, or once with its gate. Denoises the frames of `only_frames`
+/// when it is not null (one flag per latent frame), else every frame of the solved region;
+/// scores the latent frame nearest `truth_timestamp_ns` against `truth` when it is not null.
+DenoiseRecord DenoiseSolution(const Denoiser& denoiser, const DenoiseRequest& request,
+                              const Scene& scene, const MethodOptions& method,
+                              const MethodOptions& clocked, const Image* truth,
+                              int64_t truth_timestamp_ns, const std::vector<uint8_t>* only_frames,
+                              MethodResult* run);
 
 /// summary.json's "denoiser" object.
 nlohmann::ordered_json DenoiseJson(const DenoiseRecord& record);

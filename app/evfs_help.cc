@@ -1,7 +1,7 @@
-#include "app/evfs_help.h"
+#include "evfs/app/evfs_help.h"
 
-#include "app/evfs_options.h"
-#include "core/version.h"
+#include "evfs/app/evfs_options.h"
+#include "evfs/core/version.h"
 
 namespace evfs {
 namespace {

@@ -4,7 +4,7 @@
 #ifndef EVFS_APP_EVFS_HELP_H_
 #define EVFS_APP_EVFS_HELP_H_
 
-#include "app/command_line_help.h"
+#include "evfs/app/command_line_help.h"
 
 namespace evfs {
 

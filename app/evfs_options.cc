@@ -1,4 +1,4 @@
-#include "app/evfs_options.h"
+#include "evfs/app/evfs_options.h"
 
 #include <ceres/types.h>
 #include <gflags/gflags.h>
@@ -10,16 +10,16 @@
 #include <sstream>
 #include <type_traits>
 
-#include "app/calibrate_job.h"
-#include "app/denoise_job.h"
-#include "app/initialization.h"
-#include "app/method.h"
-#include "core/enum_names.h"
-#include "core/error.h"
-#include "core/time.h"
-#include "scene/event_model.h"
-#include "scene/frame_timing.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/app/calibrate_job.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/initialization.h"
+#include "evfs/app/method.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/scene/frame_timing.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 namespace {

@@ -22,12 +22,12 @@
 #include <variant>
 #include <vector>
 
-#include "app/command_line_help.h"
-#include "app/reconstruct_job.h"
-#include "app/video_job.h"
-#include "events/flicker.h"
-#include "events/frame_effects.h"
-#include "events/simulator.h"
+#include "evfs/app/command_line_help.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/app/video_job.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/frame_effects.h"
+#include "evfs/events/simulator.h"
 
 namespace evfs {
 

@@ -1,8 +1,8 @@
-#include "app/frame_lag.h"
+#include "evfs/app/frame_lag.h"
 
 #include <algorithm>
 
-#include "core/time.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 

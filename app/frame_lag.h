@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "io/data_source.h"
-#include "scene/frame_timing.h"
+#include "evfs/io/data_source.h"
+#include "evfs/scene/frame_timing.h"
 
 namespace evfs {
 

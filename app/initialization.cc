@@ -1,8 +1,8 @@
-#include "app/initialization.h"
+#include "evfs/app/initialization.h"
 
-#include "baselines/baseline.h"
-#include "core/error.h"
-#include "scene/scene.h"
+#include "evfs/baselines/baseline.h"
+#include "evfs/core/error.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -6,10 +6,10 @@
 
 #include <string>
 
-#include "baselines/baseline_options.h"
-#include "core/enum_names.h"
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/baselines/baseline_options.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

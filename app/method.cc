@@ -1,4 +1,4 @@
-#include "app/method.h"
+#include "evfs/app/method.h"
 
 #include <glog/logging.h>
 
@@ -7,13 +7,13 @@
 #include <cmath>
 #include <cstdio>
 
-#include "baselines/baseline.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "io/text_folder.h"
-#include "scene/activity_mask.h"
-#include "scene/scene.h"
+#include "evfs/baselines/baseline.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 namespace {

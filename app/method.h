@@ -13,19 +13,19 @@
 #include <string>
 #include <vector>
 
-#include "app/initialization.h"
-#include "baselines/baseline.h"
-#include "baselines/baseline_options.h"
-#include "core/enum_names.h"
-#include "core/video.h"
-#include "io/data_source.h"
-#include "scene/confidence.h"
-#include "scene/scene.h"
-#include "solver/first_order_solvers.h"
-#include "solver/iteration_callback.h"
-#include "solver/reconstruction_options.h"
-#include "solver/reconstructor.h"
-#include "solver/sharp_frame_seams.h"
+#include "evfs/app/initialization.h"
+#include "evfs/baselines/baseline.h"
+#include "evfs/baselines/baseline_options.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/video.h"
+#include "evfs/io/data_source.h"
+#include "evfs/scene/confidence.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/first_order_solvers.h"
+#include "evfs/solver/iteration_callback.h"
+#include "evfs/solver/reconstruction_options.h"
+#include "evfs/solver/reconstructor.h"
+#include "evfs/solver/sharp_frame_seams.h"
 
 namespace evfs {
 

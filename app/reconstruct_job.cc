@@ -1,4 +1,4 @@
-#include "app/reconstruct_job.h"
+#include "evfs/app/reconstruct_job.h"
 
 #include <chrono>
 #include <cmath>
@@ -8,12 +8,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "app/frame_lag.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
+#include "evfs/app/frame_lag.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {
@@ -240,23 +240,6 @@ int64_t TruthTimestamp(const DataSource& source, const ReconstructRequest& reque
   return t_ns;
 }
 
-// The denoiser on the solved latent video (plug & play, or once, gated), scored against the
-// truth when there is one.
-DenoiseRecord DenoiseSolution(const Denoiser& denoiser, const DenoiseRequest& request,
-                              const Scene& scene, const MethodOptions& method,
-                              const MethodOptions& clocked, const Image* truth,
-                              int64_t truth_timestamp_ns, MethodResult* run) {
-  const int truth_latent = truth != nullptr ? run->video.NearestFrame(truth_timestamp_ns) : -1;
-  const DenoiseRegion region = SolvedRegion(scene, method, run->solved);
-  if (request.mode == DenoiseMode::kPnp) {
-    return PlugAndPlayLatentVideo(denoiser, scene, clocked, request.pnp, region, truth,
-                                  truth_latent, run);
-  }
-  const std::unique_ptr<DenoiseGate> gate = MakeDenoiseGate(request, scene, method, *run);
-  return DenoiseLatentVideo(denoiser, request.mode, region, request.consistency ? &scene : nullptr,
-                            truth, truth_latent, &run->video, gate.get());
-}
-
 // The latent frame nearest the truth against it, beside the baseline's, and the share of its
 // pixels within the predicted error.
 void ScoreTruth(const Video& latent, const Video& baseline, const Video& sigma,
@@ -329,9 +312,9 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   result.time.solve_s = result.run.solve_time_s;
   if (denoiser != nullptr) {
     stage("denoise");
-    result.denoise =
-        DenoiseSolution(*denoiser, request.denoise, scene, request.method, method,
-                        score ? &truth_image : nullptr, result.truth.timestamp_ns, &result.run);
+    result.denoise = DenoiseSolution(*denoiser, request.denoise, scene, request.method, method,
+                                     score ? &truth_image : nullptr, result.truth.timestamp_ns,
+                                     nullptr, &result.run);
   }
   ApplySharpFrameSeams(scene, request.method, &result.run);
 

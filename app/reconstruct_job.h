@@ -8,14 +8,14 @@
 #include <functional>
 #include <string>
 
-#include "app/denoise_job.h"
-#include "app/method.h"
-#include "core/enum_names.h"
-#include "core/video.h"
-#include "io/data_source.h"
-#include "scene/confidence.h"
-#include "scene/frame_timing.h"
-#include "scene/scene.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/method.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/video.h"
+#include "evfs/io/data_source.h"
+#include "evfs/scene/confidence.h"
+#include "evfs/scene/frame_timing.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -1,16 +1,16 @@
-#include "app/reports.h"
+#include "evfs/app/reports.h"
 
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "app/frame_lag.h"
-#include "core/enum_names.h"
-#include "core/error.h"
-#include "core/time.h"
-#include "io/aedat_legacy.h"
-#include "io/rosbag.h"
+#include "evfs/app/frame_lag.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/io/aedat_legacy.h"
+#include "evfs/io/rosbag.h"
 
 namespace evfs {
 

@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <string>
 
-#include "app/reconstruct_job.h"
-#include "io/data_source.h"
-#include "scene/scene.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/io/data_source.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

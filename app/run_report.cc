@@ -1,4 +1,4 @@
-#include "app/run_report.h"
+#include "evfs/app/run_report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "io/image_io.h"
+#include "evfs/core/error.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {

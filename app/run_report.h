@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "app/reconstruct_job.h"
+#include "evfs/app/reconstruct_job.h"
 
 namespace evfs {
 

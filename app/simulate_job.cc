@@ -1,13 +1,13 @@
-#include "app/simulate_job.h"
+#include "evfs/app/simulate_job.h"
 
 #include <memory>
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "core/video.h"
-#include "io/data_source.h"
-#include "io/text_folder.h"
+#include "evfs/core/error.h"
+#include "evfs/core/video.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/text_folder.h"
 
 namespace evfs {
 

@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <string>
 
-#include "events/flicker.h"
-#include "events/frame_effects.h"
-#include "events/simulator.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/frame_effects.h"
+#include "evfs/events/simulator.h"
 
 namespace evfs {
 

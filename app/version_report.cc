@@ -1,4 +1,4 @@
-#include "app/version_report.h"
+#include "evfs/app/version_report.h"
 
 #include <ceres/version.h>
 #include <hdf5.h>
@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <opencv2/core/utility.hpp>
 
-#include "core/version.h"
+#include "evfs/core/version.h"
 
 namespace evfs {
 

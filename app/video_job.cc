@@ -1,4 +1,4 @@
-#include "app/video_job.h"
+#include "evfs/app/video_job.h"
 
 #include <sys/resource.h>
 
@@ -18,18 +18,19 @@
 #include <string_view>
 #include <thread>
 
-#include "app/frame_consistency.h"
-#include "app/run_report.h"
-#include "app/video_writer.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/option_checker.h"
-#include "core/parallel.h"
-#include "core/time.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
-#include "scene/confidence.h"
-#include "scene/scene.h"
+#include "evfs/app/run_report.h"
+#include "evfs/app/video_steps.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/parallel.h"
+#include "evfs/core/time.h"
+#include "evfs/denoiser/frame_consistency.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/video_writer.h"
+#include "evfs/scene/confidence.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 namespace {
@@ -41,10 +42,6 @@ using Json = nlohmann::ordered_json;
 // The marker of a work folder: its first line, then the run's settings.
 constexpr char kWorkMarkerFile[] = ".evfs-video-work";
 constexpr char kWorkMarkerTitle[] = "evfs video work folder";
-// Most output frames a video may have (a runaway --fps would fill the disk).
-constexpr int64_t kMaxOutputFrames = 10000000;
-// A time beyond any recording's last event, with room to add to it.
-constexpr int64_t kFarFutureNs = std::numeric_limits<int64_t>::max() / 4;
 
 // JSON has no inf or nan: they become null.
 Json Number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
@@ -216,21 +213,6 @@ std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string&
   return done;
 }
 
-// What a window depends on, for the fingerprint of a run.
-std::string PlanText(const std::vector<VideoWindow>& windows, const OutputClock& clock) {
-  std::ostringstream text;
-  for (const VideoWindow& window : windows) {
-    int64_t begin = 0, end = 0;
-    clock.FramesOf(window, &begin, &end);
-    text << window.index << ' ' << NameOf(kVideoWindowKindNames, window.kind);
-    for (const VideoWindowFrame& frame : window.frames) {
-      text << ' ' << frame.index << (frame.blurred ? "b" : "s");
-    }
-    text << ' ' << window.begin_ns << ' ' << window.end_ns << ' ' << begin << ' ' << end << '\n';
-  }
-  return text.str();
-}
-
 // Serialises reads of the recording (DataSource is not thread-safe) and names bad frames.
 class SharedSource {
  public:
@@ -241,13 +223,7 @@ class SharedSource {
 
   Image ReadImage(int index) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    try {
-      return source_->ReadImage(index);
-    } catch (const InputError& error) {
-      throw InputError(error.kind(), error.file(), error.line(),
-                       std::string("frame ") + std::to_string(index) + ": " + error.what() +
-                           " (--skip_bad_frames goes on across it)");
-    }
+    return ReadVideoFrame(*source_, index);
   }
   EventStream ReadEvents(int64_t begin_ns, int64_t end_ns) const {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -372,13 +348,10 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   DenoiseRecord denoise_record;
   if (context.denoiser != nullptr) {
     const auto denoise_start = Clock::now();
-    DenoiseRegion region = SolvedRegion(scene, context.method, run.solved);
-    region.frames = FramesTheOutputNeeds(window, scene, run.video, context, begin, end);
-    const std::unique_ptr<DenoiseGate> gate =
-        MakeDenoiseGate(request.denoise, scene, context.method, run);
-    denoise_record = DenoiseLatentVideo(*context.denoiser, request.denoise.mode, region,
-                                        request.denoise.consistency ? &scene : nullptr, nullptr, -1,
-                                        &run.video, gate.get());
+    const std::vector<uint8_t> frames_read =
+        FramesTheOutputNeeds(window, scene, run.video, context, begin, end);
+    denoise_record = DenoiseSolution(*context.denoiser, request.denoise, scene, context.method,
+                                     method, nullptr, 0, &frames_read, &run);
     denoise_s = SecondsSince(denoise_start);
   }
   ApplySharpFrameSeams(scene, context.method, &run);
@@ -544,6 +517,219 @@ void WritePreview(const std::vector<VideoWindow>& windows, const SharedSource& s
   writer.Close();
 }
 
+// The records of the windows an interrupted run finished that this run reuses: those whose
+// every output frame is still in the work folder and whose recording still gives them the same
+// frames and events. The fingerprint does not see a recording edited in place, so each
+// window's input is read again (no solve, a small part of solving it). Sets `changed` to the
+// windows left out because their input changed.
+std::map<int, Json> ReusableWindows(std::map<int, Json> records,
+                                    const std::vector<VideoWindow>& windows,
+                                    const OutputClock& clock, const fs::path& work,
+                                    const SharedSource& source, int* changed) {
+  for (auto it = records.begin(); it != records.end();) {
+    bool complete = it->first >= 0 && it->first < static_cast<int>(windows.size());
+    if (complete) {
+      int64_t begin = 0, end = 0;
+      clock.FramesOf(windows[it->first], &begin, &end);
+      for (int64_t n = begin; n < end && complete; ++n) {
+        complete = fs::is_regular_file(work / "frames" / (FrameName(n) + ".png"));
+      }
+    }
+    it = complete ? std::next(it) : records.erase(it);
+  }
+  const int recorded = static_cast<int>(records.size());
+  *changed = 0;
+  for (auto it = records.begin(); it != records.end();) {
+    const bool same = it->second.contains("input_hash") && it->second["input_hash"].is_string() &&
+                      it->second["input_hash"].get<std::string>() ==
+                          ReadWindowInputHash(windows[it->first], source);
+    if (!same) ++*changed;
+    it = same ? std::next(it) : records.erase(it);
+  }
+  if (*changed > 0) {
+    std::fprintf(stderr,
+                 "evfs: --resume: the recording changed since the interrupted run: recomputing "
+                 "%d of the %d windows it had finished\n",
+                 *changed, recorded);
+  }
+  return records;
+}
+
+// Solves the windows of `pending` and adds their records to `records`; returns how many were
+// solved. In one process (or a worker) each of `jobs` threads takes the next window as it
+// becomes free, from `pending` or, in a worker, from its coordinator; a coordinator hands them
+// out and reads back the records its workers wrote. Ends early, leaving the finished windows
+// recorded, when a window fails (its error is rethrown) or a stop is requested.
+int SolveWindows(const std::vector<VideoWindow>& windows, const std::vector<int>& pending, int jobs,
+                 const WindowContext& context, const std::string& fingerprint,
+                 VideoProgress* progress, std::map<int, Json>* records) {
+  const VideoRequest& request = *context.request;
+  const VideoDistribution* distribution = request.distribution;
+  if (distribution != nullptr && distribution->coordinator) {
+    distribution->serve(pending);
+    *records = PrepareWorkFolder(context.work, fingerprint, /*resume=*/true);
+    for (const int index : pending) {
+      if (records->count(index) != 0)
+        progress->events_done += (*records)[index]["events"].get<int64_t>();
+    }
+    return static_cast<int>(pending.size());
+  }
+  const bool worker = distribution != nullptr;
+  const auto solve_start = Clock::now();
+  std::mutex take_mutex, progress_mutex;
+  size_t next_pending = 0;
+  int solved = 0;
+  std::atomic<bool> failed(false);
+  const auto take = [&]() -> int {
+    const std::lock_guard<std::mutex> lock(take_mutex);
+    if (failed) return -1;  // an earlier window failed: the run ends with its error
+    if (request.method.interrupt != nullptr && request.method.interrupt->load()) {
+      failed = true;
+      return -1;
+    }
+    if (worker) return distribution->next();
+    return next_pending < pending.size() ? pending[next_pending++] : -1;
+  };
+  ParallelForEach(jobs, jobs, [&](int) {
+    for (int index = take(); index >= 0; index = take()) {
+      try {
+        Json record = RunWindow(windows[index], context);
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        progress->events_done += record["events"].get<int64_t>();
+        ++progress->windows_done;
+        ++solved;
+        progress->elapsed_s = SecondsSince(solve_start);
+        (*records)[index] = std::move(record);
+        if (request.progress) request.progress(*progress);
+      } catch (const InterruptedError&) {
+        // Not a failure of the run: the work folder stays for resume (the caller checks).
+        failed = true;
+      } catch (...) {
+        failed = true;
+        throw;
+      }
+    }
+  });
+  return solved;
+}
+
+// Writes the output into `out` (the OutputTarget's staging folder): frames/ and confidence/
+// (hard links into the work folder, so an interrupted assembly loses nothing), timestamps.txt,
+// video.mp4 and, with `preview`, preview.mp4. Returns video.mp4's codec. `stop_if_requested`
+// runs before each frame.
+std::string AssembleVideo(const std::vector<VideoWindow>& windows, const SharedSource& source,
+                          const OutputClock& clock, double fps, int64_t output_frames, bool preview,
+                          const fs::path& work, const fs::path& out,
+                          const std::function<void()>& stop_if_requested) {
+  fs::create_directories(out / "frames");
+  fs::create_directories(out / "confidence");
+  std::vector<int64_t> times;
+  for (int64_t n = 0; n < output_frames; ++n) {
+    stop_if_requested();
+    for (const char* folder : {"frames", "confidence"}) {
+      LinkFrame(work / folder / (FrameName(n) + ".png"), out / folder / (FrameName(n) + ".png"));
+    }
+    times.push_back(clock.TimeNs(n));
+  }
+  WriteTimestampsTxt((out / "timestamps.txt").string(), times);
+  std::string codec;
+  {
+    Mp4Writer video((out / "video.mp4").string(), fps, source.unlocked().width(),
+                    source.unlocked().height());
+    for (int64_t n = 0; n < output_frames; ++n) {
+      stop_if_requested();
+      video.WriteGrey(ReadGreyImage((work / "frames" / (FrameName(n) + ".png")).string()));
+    }
+    video.Close();
+    codec = video.codec();
+  }
+  if (preview) WritePreview(windows, source, clock, fps, work, out / "preview.mp4");
+  return codec;
+}
+
+// Every withheld frame's score in the windows' records, in window order.
+std::vector<VideoTruthScore> TruthScores(const std::vector<Json>& records) {
+  const auto number = [](const Json& score, const char* key) {
+    return score[key].is_number() ? score[key].get<double>() : 0.0;
+  };
+  std::vector<VideoTruthScore> scores;
+  for (const Json& record : records) {
+    if (!record.contains("truth")) continue;
+    for (const Json& score : record["truth"]) {
+      VideoTruthScore truth;
+      truth.psnr = number(score, "psnr");
+      truth.ssim = number(score, "ssim");
+      truth.blend_psnr = number(score, "blend_psnr");
+      truth.blend_ssim = number(score, "blend_ssim");
+      truth.has_within_sigma =
+          score.contains("within_predicted_sigma") && score["within_predicted_sigma"].is_number();
+      if (truth.has_within_sigma)
+        truth.within_sigma = score["within_predicted_sigma"].get<double>();
+      scores.push_back(truth);
+    }
+  }
+  return scores;
+}
+
+// summary.json of a finished run.
+Json VideoSummary(const VideoRequest& request, const VideoResult& result, const OutputClock& clock,
+                  const std::string& denoiser, std::vector<Json> window_records) {
+  Json summary;
+  summary["command"] = "video";
+  summary["data"] = request.data_label.empty() ? request.data_path : request.data_label;
+  summary["width"] = result.width;
+  summary["height"] = result.height;
+  summary["fps"] = Number(result.fps);
+  summary["output_frames"] = result.output_frames;
+  summary["t_begin_s"] = NanosecondsToSeconds(clock.TimeNs(0));
+  summary["resampling"] =
+      "linear between the two latent frames around each output time; sharp observed frames "
+      "exact at their own times";
+  summary["confidence"] = {
+      {"folder", "confidence"},
+      {"meaning",
+       "predicted one-sigma error of each output pixel's intensity (scene/confidence.h)"},
+      {"scale", "sigma = png value / 65535, intensities in [0, 1]"}};
+  summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
+  if (request.preview) summary["preview"] = "preview.mp4";
+  summary["solver"] = MethodName(request.method.method);
+  summary["settings"] = request.settings;
+  summary["denoiser"] = denoiser;
+  summary["events"] = result.events;
+  summary["skipped_frames"] = result.skipped_frames;
+  if (!result.exposure_tests.empty()) {
+    // Whether each exposure blurred its frame, decided from the frame and its events.
+    Json tests = Json::array();
+    for (const auto& [index, estimate] : result.exposure_tests) {
+      tests.push_back({{"frame", index},
+                       {"blurred", estimate.blurred},
+                       {"predicted_blur_rms", Number(estimate.predicted_blur_rms)},
+                       {"noise_sigma", Number(estimate.noise_sigma)}});
+    }
+    summary["exposures"] = std::move(tests);
+  }
+  if (result.truth_frames > 0) {
+    summary["truth"] = {{"frames", result.truth_frames},
+                        {"mean_psnr", Number(result.mean_psnr)},
+                        {"worst_psnr", Number(result.worst_psnr)},
+                        {"mean_ssim", Number(result.mean_ssim)},
+                        {"worst_ssim", Number(result.worst_ssim)},
+                        {"blend_mean_psnr", Number(result.mean_blend_psnr)},
+                        {"blend_mean_ssim", Number(result.mean_blend_ssim)},
+                        {"mean_within_predicted_sigma", Number(result.mean_within_sigma)}};
+  }
+  summary["run"] = {{"jobs", result.jobs},
+                    {"threads_per_window", result.threads_per_window},
+                    {"windows_resumed", result.windows_resumed},
+                    {"windows_changed", result.windows_changed},
+                    {"solve_wall_s", Number(result.solve_wall_s)},
+                    {"total_wall_s", Number(result.total_wall_s)},
+                    {"windows_per_s", Number(result.windows_per_s)},
+                    {"events_per_s", Number(result.events_per_s)}};
+  summary["windows"] = std::move(window_records);
+  return summary;
+}
+
 }  // namespace
 
 bool VideoRequest::IsValid(std::string* error) const {
@@ -641,104 +827,41 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   // Loaded before any input is read: a bad weights file fails in milliseconds.
   const std::unique_ptr<Denoiser> denoiser = LoadDenoiser(request.denoise);
   const SharedSource source(request.data_path, request.data_options);
-  CheckWholeTextRecording(source.unlocked());
   const DataSource& data = source.unlocked();
+  CheckWholeTextRecording(data);
 
   VideoResult result;
   result.width = data.width();
   result.height = data.height();
   // From the declared size, before a frame is decoded (each window needs two latent frames).
   CheckSensorFitsLatentVoxels(result.width, result.height, request.binning);
+
+  // Plan: which frames, which of them blurred, the windows, the output clock.
   VideoWindowOptions window_options = request.windows;
   if (request.skip_bad_frames) {
-    const int last = window_options.last >= 0
-                         ? std::min<int>(window_options.last, data.frames().size() - 1)
-                         : static_cast<int>(data.frames().size()) - 1;
-    for (int i = std::max(window_options.first, 0); i <= last; ++i) {
-      try {
-        source.ReadImage(i);
-      } catch (const InputError&) {
-        window_options.excluded_frames.push_back(i);
-        result.skipped_frames.push_back(i);
-      }
-    }
+    result.skipped_frames = FindUnreadableFrames(data, window_options);
+    window_options.excluded_frames.insert(window_options.excluded_frames.end(),
+                                          result.skipped_frames.begin(),
+                                          result.skipped_frames.end());
   }
-  if (window_options.blur_from_data && data.has_events()) {
-    for (const int i : SelectedFrames(static_cast<int>(data.frames().size()), window_options)) {
-      int64_t begin_ns = 0, end_ns = 0;
-      if (!BlurCandidateExposure(data.frames()[i], window_options, &begin_ns, &end_ns)) continue;
-      const ExposureBlurEstimate estimate = ExposureBlur(
-          source.ReadImage(i), source.ReadEvents(begin_ns, end_ns + 1), begin_ns, end_ns);
-      if (!estimate.blurred) window_options.sharp_frames.push_back(i);
-      result.exposure_tests.emplace_back(i, estimate);
-    }
+  result.exposure_tests = TestExposures(data, window_options);
+  for (const auto& [index, estimate] : result.exposure_tests) {
+    if (!estimate.blurred) window_options.sharp_frames.push_back(index);
   }
-  // The prediction tail ends at the last event: planned first against a far end, then once
-  // more against the last event actually found there.
-  std::vector<VideoWindow> windows =
-      PlanVideoWindows(data.frames(), data.has_events(), kFarFutureNs, window_options);
-  if (data.has_events() && windows.back().kind == VideoWindowKind::kPredict) {
-    const VideoWindow& tail = windows.back();
-    int64_t last_event_ns = 0;
-    if (tail.end_ns >= kFarFutureNs) {
-      last_event_ns = data.Summarize().t_last_ns;
-    } else {
-      const EventStream events = source.ReadEvents(tail.frames[0].t_ns, tail.end_ns);
-      // No event after the last frame: a time before it, so that no tail is planned.
-      last_event_ns = events.empty() ? tail.frames[0].t_ns - 1 : events.last_t_ns();
-    }
-    windows = PlanVideoWindows(data.frames(), true, last_event_ns, window_options);
-  }
+  const std::vector<VideoWindow> windows = PlanVideo(data, window_options);
   result.windows = static_cast<int>(windows.size());
+  result.fps = VideoOutputFps(request.fps, windows);
+  const OutputClock clock(windows.front().output_begin_ns, result.fps);
+  result.output_frames = CheckVideoOutput(windows, clock, result.fps, result.width, result.height);
 
-  double fps = request.fps;
-  if (fps == 0.0) {
-    // The observed frames' mean rate (over the interpolation windows, or the one window's
-    // length when there are none), times the upsampling.
-    int gaps = 0;
-    int64_t span_ns = 0;
-    for (const VideoWindow& window : windows) {
-      if (window.kind != VideoWindowKind::kInterpolate) continue;
-      ++gaps;
-      span_ns += window.output_end_ns - window.output_begin_ns;
-    }
-    if (gaps == 0) {
-      gaps = 1;
-      span_ns = windows.front().output_end_ns - windows.front().output_begin_ns;
-    }
-    const double observed_rate = gaps / std::max(NanosecondsToSeconds(span_ns), 1e-9);
-    fps = std::round(kDefaultUpsampling * observed_rate);
-    fps = std::max(fps, 1.0);
-  }
-  result.fps = fps;
-  const OutputClock clock(windows.front().output_begin_ns, fps);
-  int64_t ignored = 0;
-  clock.FramesOf(windows.back(), &ignored, &result.output_frames);
-  if (result.output_frames > kMaxOutputFrames) {
-    throw InvalidArgumentError("--fps=" + std::to_string(fps) + " would make " +
-                               std::to_string(result.output_frames) + " frames, more than " +
-                               std::to_string(kMaxOutputFrames));
-  }
-  // Each window holds its resampled frames and confidence maps until it writes them.
-  int64_t longest_ns = 0;
-  for (const VideoWindow& window : windows) {
-    longest_ns = std::max(longest_ns, window.output_end_ns - window.output_begin_ns);
-  }
-  CheckResampledOutputFits(fps, NanosecondsToSeconds(longest_ns), result.width, result.height,
-                           "longest window");
-
-  // The run's fingerprint: what must not change for --resume to reuse windows.
-  std::ostringstream fingerprint;
-  fingerprint << "data " << fs::absolute(request.data_path).lexically_normal().string() << "\n"
-              << "fps " << fps << "\n"
-              << "settings " << request.settings << "\n"
-              << PlanText(windows, clock);
+  // The work folder: the windows an interrupted run finished, and those left to solve.
+  const std::string fingerprint =
+      VideoFingerprint(request.data_path, result.fps, request.settings, windows, clock);
   const fs::path work = VideoWorkFolder(out_path);
-  const VideoDistribution* distribution = request.distribution;
-  const bool worker = distribution != nullptr && !distribution->coordinator;
+  const bool worker = request.distribution != nullptr && !request.distribution->coordinator;
   // A worker process writes into the work folder its coordinator prepared.
   std::map<int, Json> records =
-      worker ? std::map<int, Json>() : PrepareWorkFolder(work, fingerprint.str(), request.resume);
+      worker ? std::map<int, Json>() : PrepareWorkFolder(work, fingerprint, request.resume);
   // The work folder outlives a signal (that is what --resume is for), not an error: a run that
   // failed leaves nothing behind.
   struct RemoveOnError {
@@ -748,35 +871,8 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
       if (armed && IsOwnWorkFolder(folder)) RemoveWorkFolder(folder);
     }
   } remove_on_error{work, !worker};
-  for (auto it = records.begin(); it != records.end();) {
-    // A recorded window is reused only when every frame it wrote is still there.
-    bool complete = it->first >= 0 && it->first < result.windows;
-    if (complete) {
-      int64_t begin = 0, end = 0;
-      clock.FramesOf(windows[it->first], &begin, &end);
-      for (int64_t n = begin; n < end && complete; ++n) {
-        complete = fs::is_regular_file(work / "frames" / (FrameName(n) + ".png"));
-      }
-    }
-    it = complete ? std::next(it) : records.erase(it);
-  }
-  // A recorded window is reused only when the recording still gives it the same frames and
-  // events: the settings' fingerprint above does not see a recording edited in place. Each
-  // window's input is read again (no solve), which costs a small part of solving it.
-  const int windows_recorded = static_cast<int>(records.size());
-  for (auto it = records.begin(); it != records.end();) {
-    const bool same = it->second.contains("input_hash") && it->second["input_hash"].is_string() &&
-                      it->second["input_hash"].get<std::string>() ==
-                          ReadWindowInputHash(windows[it->first], source);
-    if (!same) ++result.windows_changed;
-    it = same ? std::next(it) : records.erase(it);
-  }
-  if (result.windows_changed > 0) {
-    std::fprintf(stderr,
-                 "evfs: --resume: the recording changed since the interrupted run: recomputing "
-                 "%d of the %d windows it had finished\n",
-                 result.windows_changed, windows_recorded);
-  }
+  records =
+      ReusableWindows(std::move(records), windows, clock, work, source, &result.windows_changed);
   result.windows_resumed = static_cast<int>(records.size());
   std::vector<int> pending;
   for (const VideoWindow& window : windows) {
@@ -784,22 +880,17 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   }
   OrderLongestFirst(windows, &pending);
 
+  // Solve.
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  const int threads_per_window =
-      request.threads_per_window > 0
-          ? request.threads_per_window
-          : std::max(1, cores / std::max(1, request.jobs > 0 ? request.jobs : cores));
-  std::string capped_because;
-  result.jobs =
-      CapVideoJobs(request.jobs > 0 ? request.jobs : cores, static_cast<int>(pending.size()), cores,
-                   threads_per_window, static_cast<int64_t>(result.width) * result.height,
-                   AddressSpaceLimit(), &capped_because);
-  if (request.jobs > 0 && result.jobs < request.jobs && request.notice) {
+  const VideoSchedule schedule =
+      ScheduleVideo(request.jobs, request.threads_per_window, static_cast<int>(pending.size()),
+                    cores, static_cast<int64_t>(result.width) * result.height, AddressSpaceLimit());
+  result.jobs = schedule.jobs;
+  result.threads_per_window = schedule.threads_per_window;
+  if (!schedule.lowered_because.empty() && request.notice) {
     request.notice("--jobs=" + std::to_string(request.jobs) + " lowered to " +
-                   std::to_string(result.jobs) + ": " + capped_because);
+                   std::to_string(result.jobs) + ": " + schedule.lowered_because);
   }
-  result.threads_per_window = request.threads_per_window > 0 ? request.threads_per_window
-                                                             : std::max(1, cores / result.jobs);
   WindowContext context;
   context.request = &request;
   context.source = &source;
@@ -809,68 +900,18 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   context.method.adam.num_threads = result.threads_per_window;
   context.method.lbfgs.num_threads = result.threads_per_window;
   context.denoiser = denoiser.get();
-  std::mutex progress_mutex;
   context.work = work;
-
   VideoProgress progress;
   progress.windows_total = result.windows;
   progress.windows_done = progress.windows_resumed = result.windows_resumed;
-  std::atomic<bool> failed(false);
-  const auto solve_start = Clock::now();
-  // Each of the --jobs threads takes the next window as it becomes free: from the pending
-  // list, or, in a worker process, from its coordinator.
-  std::mutex take_mutex;
-  size_t next_pending = 0;
-  int solved = 0;
-  const auto stop_requested = [&request] {
-    return request.method.interrupt != nullptr && request.method.interrupt->load();
-  };
   const auto stop_if_requested = [&] {
-    if (!stop_requested()) return;
+    if (request.method.interrupt == nullptr || !request.method.interrupt->load()) return;
     remove_on_error.armed = false;
     throw InterruptedError("interrupted: the windows finished so far are kept for --resume");
   };
-  const auto take = [&]() -> int {
-    const std::lock_guard<std::mutex> lock(take_mutex);
-    if (failed) return -1;  // an earlier window failed: the run ends with its error
-    if (stop_requested()) {
-      failed = true;
-      return -1;
-    }
-    if (worker) return distribution->next();
-    return next_pending < pending.size() ? pending[next_pending++] : -1;
-  };
-  if (distribution != nullptr && distribution->coordinator) {
-    distribution->serve(pending);
-    // The workers' records, as they wrote them.
-    records = PrepareWorkFolder(work, fingerprint.str(), /*resume=*/true);
-    solved = static_cast<int>(pending.size());
-    for (const int index : pending) {
-      if (records.count(index) != 0)
-        progress.events_done += records[index]["events"].get<int64_t>();
-    }
-  } else {
-    ParallelForEach(result.jobs, result.jobs, [&](int) {
-      for (int index = take(); index >= 0; index = take()) {
-        try {
-          Json record = RunWindow(windows[index], context);
-          const std::lock_guard<std::mutex> lock(progress_mutex);
-          progress.events_done += record["events"].get<int64_t>();
-          ++progress.windows_done;
-          ++solved;
-          progress.elapsed_s = SecondsSince(solve_start);
-          records[index] = std::move(record);
-          if (request.progress) request.progress(progress);
-        } catch (const InterruptedError&) {
-          // Not a failure of the run: the work folder stays for resume (checked below).
-          failed = true;
-        } catch (...) {
-          failed = true;
-          throw;
-        }
-      }
-    });
-  }
+  const auto solve_start = Clock::now();
+  const int solved =
+      SolveWindows(windows, pending, result.jobs, context, fingerprint, &progress, &records);
   stop_if_requested();
   result.solve_wall_s = SecondsSince(solve_start);
   result.windows_per_s = result.solve_wall_s > 0.0 ? solved / result.solve_wall_s : 0.0;
@@ -881,122 +922,23 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
     return result;
   }
 
-  // Assembly, in the OutputTarget's staging folder.
+  // Assemble and sum up, in the OutputTarget's staging folder.
   const fs::path out = staging;
-  fs::create_directories(out / "frames");
-  fs::create_directories(out / "confidence");
-  std::vector<int64_t> times;
-  for (int64_t n = 0; n < result.output_frames; ++n) {
-    stop_if_requested();
-    for (const char* folder : {"frames", "confidence"}) {
-      LinkFrame(work / folder / (FrameName(n) + ".png"), out / folder / (FrameName(n) + ".png"));
-    }
-    times.push_back(clock.TimeNs(n));
-  }
-  WriteTimestampsTxt((out / "timestamps.txt").string(), times);
-  {
-    Mp4Writer video((out / "video.mp4").string(), fps, result.width, result.height);
-    for (int64_t n = 0; n < result.output_frames; ++n) {
-      stop_if_requested();
-      video.WriteGrey(ReadGreyImage((work / "frames" / (FrameName(n) + ".png")).string()));
-    }
-    video.Close();
-    result.codec = video.codec();
-  }
-  if (request.preview) WritePreview(windows, source, clock, fps, work, out / "preview.mp4");
-
-  Json window_records = Json::array();
-  std::vector<double> psnr, ssim, blend_psnr, blend_ssim, within_sigma;
+  result.codec = AssembleVideo(windows, source, clock, result.fps, result.output_frames,
+                               request.preview, work, out, stop_if_requested);
+  std::vector<Json> window_records;
   for (int i = 0; i < result.windows; ++i) {
-    const Json& record = records.at(i);
-    result.events += record["events"].get<int64_t>();
-    if (record.contains("truth")) {
-      for (const Json& score : record["truth"]) {
-        psnr.push_back(score["psnr"].is_number() ? score["psnr"].get<double>() : 0.0);
-        ssim.push_back(score["ssim"].is_number() ? score["ssim"].get<double>() : 0.0);
-        blend_psnr.push_back(score["blend_psnr"].is_number() ? score["blend_psnr"].get<double>()
-                                                             : 0.0);
-        blend_ssim.push_back(score["blend_ssim"].is_number() ? score["blend_ssim"].get<double>()
-                                                             : 0.0);
-        if (score.contains("within_predicted_sigma") && score["within_predicted_sigma"].is_number())
-          within_sigma.push_back(score["within_predicted_sigma"].get<double>());
-      }
-    }
-    window_records.push_back(record);
+    window_records.push_back(records.at(i));
+    result.events += window_records.back()["events"].get<int64_t>();
   }
-  const auto mean = [](const std::vector<double>& values) {
-    double sum = 0.0;
-    for (const double value : values) sum += value;
-    return values.empty() ? 0.0 : sum / values.size();
-  };
-  const auto worst = [](const std::vector<double>& values) {
-    return values.empty() ? 0.0 : *std::min_element(values.begin(), values.end());
-  };
-  result.truth_frames = static_cast<int>(psnr.size());
-  result.mean_psnr = mean(psnr);
-  result.worst_psnr = worst(psnr);
-  result.mean_ssim = mean(ssim);
-  result.worst_ssim = worst(ssim);
-  result.mean_blend_psnr = mean(blend_psnr);
-  result.mean_blend_ssim = mean(blend_ssim);
-  result.mean_within_sigma = mean(within_sigma);
+  SummarizeTruth(TruthScores(window_records), &result);
   result.total_wall_s = SecondsSince(total_start);
-
-  Json summary;
-  summary["command"] = "video";
-  summary["data"] = request.data_label.empty() ? request.data_path : request.data_label;
-  summary["width"] = result.width;
-  summary["height"] = result.height;
-  summary["fps"] = Number(fps);
-  summary["output_frames"] = result.output_frames;
-  summary["t_begin_s"] = NanosecondsToSeconds(clock.TimeNs(0));
-  summary["resampling"] =
-      "linear between the two latent frames around each output time; sharp observed frames "
-      "exact at their own times";
-  summary["confidence"] = {
-      {"folder", "confidence"},
-      {"meaning",
-       "predicted one-sigma error of each output pixel's intensity (scene/confidence.h)"},
-      {"scale", "sigma = png value / 65535, intensities in [0, 1]"}};
-  summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
-  if (request.preview) summary["preview"] = "preview.mp4";
-  summary["solver"] = MethodName(request.method.method);
-  summary["settings"] = request.settings;
-  summary["denoiser"] =
+  const std::string denoiser_name =
       denoiser != nullptr ? NameOf(kDenoiseModeNames, request.denoise.mode) : "none";
-  summary["events"] = result.events;
-  summary["skipped_frames"] = result.skipped_frames;
-  if (!result.exposure_tests.empty()) {
-    // Whether each exposure blurred its frame, decided from the frame and its events.
-    Json tests = Json::array();
-    for (const auto& [index, estimate] : result.exposure_tests) {
-      tests.push_back({{"frame", index},
-                       {"blurred", estimate.blurred},
-                       {"predicted_blur_rms", Number(estimate.predicted_blur_rms)},
-                       {"noise_sigma", Number(estimate.noise_sigma)}});
-    }
-    summary["exposures"] = std::move(tests);
-  }
-  if (result.truth_frames > 0) {
-    summary["truth"] = {{"frames", result.truth_frames},
-                        {"mean_psnr", Number(result.mean_psnr)},
-                        {"worst_psnr", Number(result.worst_psnr)},
-                        {"mean_ssim", Number(result.mean_ssim)},
-                        {"worst_ssim", Number(result.worst_ssim)},
-                        {"blend_mean_psnr", Number(result.mean_blend_psnr)},
-                        {"blend_mean_ssim", Number(result.mean_blend_ssim)},
-                        {"mean_within_predicted_sigma", Number(result.mean_within_sigma)}};
-  }
-  summary["run"] = {{"jobs", result.jobs},
-                    {"threads_per_window", result.threads_per_window},
-                    {"windows_resumed", result.windows_resumed},
-                    {"windows_changed", result.windows_changed},
-                    {"solve_wall_s", Number(result.solve_wall_s)},
-                    {"total_wall_s", Number(result.total_wall_s)},
-                    {"windows_per_s", Number(result.windows_per_s)},
-                    {"events_per_s", Number(result.events_per_s)}};
-  summary["windows"] = std::move(window_records);
-  WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  WriteFileAtomically(
+      out / "summary.json",
+      VideoSummary(request, result, clock, denoiser_name, std::move(window_records)).dump(2) +
+          "\n");
   if (request.report) WriteRunReport(out.string());
   remove_on_error.armed = false;
   return result;

@@ -27,11 +27,11 @@
 #include <utility>
 #include <vector>
 
-#include "app/denoise_job.h"
-#include "app/method.h"
-#include "app/video_windows.h"
-#include "events/binning.h"
-#include "scene/exposure_blur.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/method.h"
+#include "evfs/app/video_windows.h"
+#include "evfs/events/binning.h"
+#include "evfs/scene/exposure_blur.h"
 
 namespace evfs {
 

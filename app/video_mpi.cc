@@ -1,8 +1,8 @@
-#include "app/video_mpi.h"
+#include "evfs/app/video_mpi.h"
 
 #include <cstdlib>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 #ifdef EVFS_WITH_MPI
 #include <mpi.h>

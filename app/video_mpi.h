@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "app/video_job.h"
+#include "evfs/app/video_job.h"
 
 namespace evfs {
 

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "core/enum_names.h"
-#include "io/data_source.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

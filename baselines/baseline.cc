@@ -1,16 +1,16 @@
-#include "baselines/baseline.h"
+#include "evfs/baselines/baseline.h"
 
 #include <cstdio>
 #include <set>
 
-#include "baselines/complementary_filter.h"
-#include "baselines/event_double_integral.h"
-#include "baselines/event_integration.h"
-#include "baselines/scalar_search.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "scene/event_model_estimation.h"
-#include "scene/scene.h"
+#include "evfs/baselines/complementary_filter.h"
+#include "evfs/baselines/event_double_integral.h"
+#include "evfs/baselines/event_integration.h"
+#include "evfs/baselines/scalar_search.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 namespace {

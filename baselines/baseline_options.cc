@@ -1,10 +1,10 @@
-#include "baselines/baseline_options.h"
+#include "evfs/baselines/baseline_options.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/error.h"
-#include "core/option_checker.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
 
 namespace evfs {
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "scene/event_model_estimation.h"
+#include "evfs/scene/event_model_estimation.h"
 
 namespace evfs {
 

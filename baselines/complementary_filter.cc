@@ -1,12 +1,12 @@
-#include "baselines/complementary_filter.h"
+#include "evfs/baselines/complementary_filter.h"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "baselines/event_integration.h"
-#include "core/error.h"
-#include "core/time.h"
+#include "evfs/baselines/event_integration.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 namespace {

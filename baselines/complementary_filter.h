@@ -14,9 +14,9 @@
 #ifndef EVFS_BASELINES_COMPLEMENTARY_FILTER_H_
 #define EVFS_BASELINES_COMPLEMENTARY_FILTER_H_
 
-#include "baselines/baseline_options.h"
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/baselines/baseline_options.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "baselines/event_double_integral.h"
+#include "evfs/baselines/event_double_integral.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
-#include "baselines/event_integration.h"
-#include "baselines/scalar_search.h"
-#include "core/error.h"
+#include "evfs/baselines/event_integration.h"
+#include "evfs/baselines/scalar_search.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -27,9 +27,9 @@
 #ifndef EVFS_BASELINES_EVENT_DOUBLE_INTEGRAL_H_
 #define EVFS_BASELINES_EVENT_DOUBLE_INTEGRAL_H_
 
-#include "baselines/baseline_options.h"
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/baselines/baseline_options.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

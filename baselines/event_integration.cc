@@ -1,11 +1,11 @@
-#include "baselines/event_integration.h"
+#include "evfs/baselines/event_integration.h"
 
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

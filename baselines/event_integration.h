@@ -19,9 +19,9 @@
 
 #include <vector>
 
-#include "baselines/baseline_options.h"
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/baselines/baseline_options.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

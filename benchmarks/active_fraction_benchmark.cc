@@ -16,13 +16,13 @@
 #include <string>
 #include <vector>
 
-#include "app/allocator_tuning.h"
-#include "app/method.h"
-#include "core/metrics.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "solver/reconstructor.h"
-#include "solver/sharp_frame_seams.h"
+#include "evfs/app/method.h"
+#include "evfs/core/metrics.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/runtime/allocator_tuning.h"
+#include "evfs/solver/reconstructor.h"
+#include "evfs/solver/sharp_frame_seams.h"
 
 DEFINE_string(fractions, "0,0.05,0.1,0.25,0.5,0.75,1",
               "Comma-separated fractions of the image width that move.");

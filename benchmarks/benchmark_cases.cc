@@ -1,14 +1,14 @@
-#include "benchmarks/benchmark_cases.h"
+#include "evfs/benchmarks/benchmark_cases.h"
 
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "events/simulator.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {

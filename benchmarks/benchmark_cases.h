@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "core/event_stream.h"
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

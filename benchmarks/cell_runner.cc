@@ -1,4 +1,4 @@
-#include "benchmarks/cell_runner.h"
+#include "evfs/benchmarks/cell_runner.h"
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/crash_guard.h"
+#include "evfs/runtime/crash_guard.h"
 
 namespace evfs {
 

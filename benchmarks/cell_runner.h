@@ -1,6 +1,6 @@
 // Running one benchmark cell in a process of its own, so that its peak memory (the child's
 // ru_maxrss) and CPU time are its own, and a cell that runs too long or takes too much memory
-// fails alone. The process isolation is the CLI's (ForkAndWait, app/crash_guard.h); the
+// fails alone. The process isolation is the CLI's (ForkAndWait, runtime/crash_guard.h); the
 // cell adds a time limit (SIGALRM), an address-space limit (RLIMIT_AS) and a result file.
 #ifndef EVFS_BENCHMARKS_CELL_RUNNER_H_
 #define EVFS_BENCHMARKS_CELL_RUNNER_H_

@@ -20,15 +20,15 @@
 #include <string>
 #include <vector>
 
-#include "cost_functions/difference_residual.h"
-#include "cost_functions/event_residual.h"
-#include "cost_functions/frame_residual.h"
-#include "cost_functions/spatial_tv_residual.h"
-#include "scene/activity_mask.h"
-#include "scene/event_model.h"
-#include "solver/first_order_solvers.h"
-#include "solver/fused_objective.h"
-#include "solver/problem_builder.h"
+#include "evfs/cost_functions/difference_residual.h"
+#include "evfs/cost_functions/event_residual.h"
+#include "evfs/cost_functions/frame_residual.h"
+#include "evfs/cost_functions/spatial_tv_residual.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/solver/first_order_solvers.h"
+#include "evfs/solver/fused_objective.h"
+#include "evfs/solver/problem_builder.h"
 
 namespace evfs {
 namespace {

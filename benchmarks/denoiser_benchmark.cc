@@ -14,7 +14,7 @@
 //   0 and 4) and deblurred (the mean of frames 0–7), slider_depth prediction, shapes_rotation
 //   interpolation (frame 3 from 2 and 4) and eslnet_cups deblur (no truth: re-blur PSNR and
 //   sharpness). Rows: the model-based reconstruction alone (DMR), DMR + the residual denoiser
-//   applied once (RD) and in plug & play (app/plug_and_play.h), and DMR + two generic
+//   applied once (RD) and in plug & play (plug_and_play/plug_and_play.h), and DMR + two generic
 //   denoisers with their strength tuned on the truth (OpenCV's fastNlMeansDenoising and its
 //   TV-L1 denoiser, run on the scored frames only), PSNR / SSIM and ms per frame. With --out, a
 //   picture per case (DMR | DMR + RD | truth, a zoomed crop below), as the paper's Fig. 7.
@@ -37,15 +37,15 @@
 #include <string>
 #include <vector>
 
-#include "app/denoise_job.h"
-#include "app/method.h"
-#include "app/plug_and_play.h"
-#include "app/reconstruct_job.h"
-#include "benchmarks/benchmark_cases.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "denoiser/denoiser.h"
-#include "io/data_source.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/method.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/benchmarks/benchmark_cases.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/denoiser/denoiser.h"
+#include "evfs/io/data_source.h"
+#include "evfs/plug_and_play/plug_and_play.h"
 
 DEFINE_string(weights, "", "The denoiser's ONNX file; empty: the shipped weights.");
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");

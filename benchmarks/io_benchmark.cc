@@ -10,9 +10,9 @@
 #include <random>
 #include <string>
 
-#include "core/event_stream.h"
-#include "io/event_text.h"
-#include "io/hdf5_io.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/io/event_text.h"
+#include "evfs/io/hdf5_io.h"
 
 namespace evfs {
 namespace {

@@ -28,11 +28,11 @@
 #include <tuple>
 #include <vector>
 
-#include "core/error.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "io/text_folder.h"
+#include "evfs/core/error.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/text_folder.h"
 
 DEFINE_string(out, "",
               "Folder to write hot_pixel/ and busy_640x480/ into (created; must not "

@@ -31,17 +31,17 @@
 #include <string>
 #include <vector>
 
-#include "app/allocator_tuning.h"
-#include "app/method.h"
-#include "app/reconstruct_job.h"
-#include "baselines/baseline.h"
-#include "benchmarks/benchmark_cases.h"
-#include "benchmarks/cell_runner.h"
-#include "benchmarks/method_results.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "scene/scene.h"
+#include "evfs/app/method.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/baselines/baseline.h"
+#include "evfs/benchmarks/benchmark_cases.h"
+#include "evfs/benchmarks/cell_runner.h"
+#include "evfs/benchmarks/method_results.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/runtime/allocator_tuning.h"
+#include "evfs/scene/scene.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
 DEFINE_string(out, "build/bench",

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "app/method.h"
+#include "evfs/app/method.h"
 
 namespace evfs {
 

@@ -25,15 +25,15 @@
 #include <string>
 #include <vector>
 
-#include "app/allocator_tuning.h"
-#include "app/denoise_job.h"
-#include "app/reconstruct_job.h"
-#include "benchmarks/benchmark_cases.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "events/simulator.h"
-#include "solver/reconstructor.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/benchmarks/benchmark_cases.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/events/simulator.h"
+#include "evfs/runtime/allocator_tuning.h"
+#include "evfs/solver/reconstructor.h"
 
 DEFINE_string(data, EVFS_DATA_DIR, "The shared data folder.");
 DEFINE_string(cases, "slider,shapes,cups,clips", "Comma-separated cases to run.");

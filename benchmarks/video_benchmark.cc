@@ -19,15 +19,15 @@
 #include <string>
 #include <vector>
 
-#include "benchmarks/cell_runner.h"
-#include "core/metrics.h"
-#include "core/time.h"
-#include "core/video.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
-#include "io/text_folder.h"
+#include "evfs/benchmarks/cell_runner.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/time.h"
+#include "evfs/core/video.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/text_folder.h"
 
 DEFINE_string(work_dir, "", "Scratch folder for the recordings and outputs (created; under /tmp).");
 DEFINE_string(evfs, EVFS_BINARY, "The evfs binary.");

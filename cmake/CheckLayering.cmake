@@ -1,5 +1,5 @@
-# The `layering` test: every #include "module/..." of every source under a module folder must be
-# an edge of cmake/layers.txt. Run as
+# The `layering` test: every #include "evfs/module/..." of every source under a module folder
+# must be an edge of cmake/layers.txt, and a module's header is never included without evfs/. Run as
 #   cmake -DSOURCE_DIR=<repository root> -P cmake/CheckLayering.cmake
 # Prints each forbidden edge (file, line, included header) and fails when there is one.
 cmake_minimum_required(VERSION 3.18)
@@ -18,6 +18,16 @@ foreach(module IN LISTS modules)
     file(STRINGS "${source}" includes REGEX "^[ \t]*#[ \t]*include[ \t]*\"")
     foreach(line IN LISTS includes)
       string(REGEX MATCH "\"([^\"/]+)/[^\"]*\"" header "${line}")
+      if(NOT header)
+        continue()
+      endif()
+      if(CMAKE_MATCH_1 IN_LIST modules)
+        file(RELATIVE_PATH relative "${SOURCE_DIR}" "${source}")
+        message("${relative}: ${header} names a module of evfs without evfs/ (write \"evfs/...\")")
+        math(EXPR violations "${violations} + 1")
+        continue()
+      endif()
+      string(REGEX MATCH "\"evfs/([^\"/]+)/[^\"]*\"" header "${line}")
       if(NOT header)
         continue()
       endif()

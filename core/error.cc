@@ -1,4 +1,4 @@
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 #include <utility>
 

@@ -1,4 +1,4 @@
-#include "core/event_frames.h"
+#include "evfs/core/event_frames.h"
 
 #include <cmath>
 

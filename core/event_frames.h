@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "core/event_stream.h"
+#include "evfs/core/event_stream.h"
 
 #include <algorithm>
 

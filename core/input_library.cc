@@ -1,4 +1,4 @@
-#include "core/input_library.h"
+#include "evfs/core/input_library.h"
 
 #include <sys/syscall.h>
 #include <unistd.h>

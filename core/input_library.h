@@ -3,8 +3,8 @@
 // Some libraries that read input files dereference what they read without checking it, so a
 // corrupt file crashes them where no error can be caught (libhdf5 1.10: docs/robustness.md). A
 // reader marks each stretch of such a library's calls with a ScopedInputLibraryRead; the process
-// runtime (app/crash_guard.h), which owns the crash handling, asks InputLibraryOfThisThread() in
-// its crash handler and reports a crash inside a marked stretch as the input file's fault. Every
+// runtime (runtime/crash_guard.h), which owns the crash handling, asks InputLibraryOfThisThread()
+// in its crash handler and reports a crash inside a marked stretch as the input file's fault. Every
 // other crash stays an internal error. Neither side knows the other: a format reader names its
 // library, and the runtime reports whichever it finds.
 #ifndef EVFS_CORE_INPUT_LIBRARY_H_

@@ -2,7 +2,7 @@
 #ifndef EVFS_CORE_METRICS_H_
 #define EVFS_CORE_METRICS_H_
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "core/parallel.h"
+#include "evfs/core/parallel.h"
 
 #include <algorithm>
 #include <atomic>

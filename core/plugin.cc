@@ -1,4 +1,4 @@
-#include "core/plugin.h"
+#include "evfs/core/plugin.h"
 
 #include <dlfcn.h>
 #include <stdlib.h>

@@ -1,10 +1,10 @@
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 #include <algorithm>
 #include <string>
 
-#include "core/error.h"
-#include "core/time.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 

@@ -13,8 +13,8 @@
 #include <ceres/sized_cost_function.h>
 #include <glog/logging.h>
 
-#include "cost_functions/scalar_parameter_blocks.h"
-#include "scene/event_model.h"
+#include "evfs/cost_functions/scalar_parameter_blocks.h"
+#include "evfs/scene/event_model.h"
 
 namespace evfs {
 

@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "cost_functions/scalar_parameter_blocks.h"
+#include "evfs/cost_functions/scalar_parameter_blocks.h"
 
 namespace evfs {
 

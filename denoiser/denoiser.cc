@@ -1,4 +1,4 @@
-#include "denoiser/denoiser.h"
+#include "evfs/denoiser/denoiser.h"
 
 #include <algorithm>
 #include <chrono>
@@ -17,10 +17,10 @@
 #include <sstream>
 #include <thread>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "core/parallel.h"
-#include "denoiser/sha256.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/parallel.h"
+#include "evfs/denoiser/sha256.h"
 
 namespace evfs {
 namespace {

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "denoiser/sha256.h"
+#include "evfs/denoiser/sha256.h"
 
 #include <array>
 #include <cstdint>

@@ -1,12 +1,12 @@
-#include "events/binning.h"
+#include "evfs/events/binning.h"
 
 #include <algorithm>
 #include <functional>
 #include <limits>
 #include <vector>
 
-#include "core/error.h"
-#include "core/option_checker.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
 
 namespace evfs {
 namespace {

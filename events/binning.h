@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "core/event_frames.h"
-#include "core/event_stream.h"
+#include "evfs/core/event_frames.h"
+#include "evfs/core/event_stream.h"
 
 namespace evfs {
 

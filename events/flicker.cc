@@ -1,10 +1,10 @@
-#include "events/flicker.h"
+#include "evfs/events/flicker.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/option_checker.h"
-#include "core/time.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 namespace {

@@ -22,7 +22,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

@@ -1,11 +1,11 @@
-#include "events/frame_effects.h"
+#include "evfs/events/frame_effects.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "core/time.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 namespace {

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
-#include "events/flicker.h"
-#include "events/random.h"
+#include "evfs/core/video.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/random.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "events/noise_filter.h"
+#include "evfs/events/noise_filter.h"
 
 #include <algorithm>
 #include <cstdlib>

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/event_stream.h"
+#include "evfs/core/event_stream.h"
 
 namespace evfs {
 

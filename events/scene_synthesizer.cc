@@ -1,12 +1,12 @@
-#include "events/scene_synthesizer.h"
+#include "evfs/events/scene_synthesizer.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "core/time.h"
-#include "events/random.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
+#include "evfs/events/random.h"
 
 namespace evfs {
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

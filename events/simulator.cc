@@ -1,13 +1,13 @@
-#include "events/simulator.h"
+#include "evfs/events/simulator.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "core/time.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 namespace {

@@ -30,10 +30,10 @@
 #include <string>
 #include <vector>
 
-#include "core/event_stream.h"
-#include "core/video.h"
-#include "events/flicker.h"
-#include "events/random.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/random.h"
 
 namespace evfs {
 

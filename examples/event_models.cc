@@ -8,12 +8,12 @@
 #include <exception>
 #include <vector>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "scene/scene.h"
-#include "solver/reconstructor.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstructor.h"
 
 int main() {
   try {

@@ -32,36 +32,36 @@
 #include <system_error>
 #include <vector>
 
-#include "app/allocator_tuning.h"
-#include "app/calibrate_job.h"
-#include "app/crash_guard.h"
-#include "app/demo.h"
-#include "app/denoise_job.h"
-#include "app/evfs_help.h"
-#include "app/evfs_options.h"
-#include "app/progress.h"
-#include "app/reconstruct_job.h"
-#include "app/reports.h"
-#include "app/run_report.h"
-#include "app/simulate_job.h"
-#include "app/version_report.h"
-#include "app/video_job.h"
-#include "app/video_mpi.h"
-#include "core/enum_names.h"
-#include "core/error.h"
-#include "core/time.h"
-#include "core/version.h"
-#include "events/binning.h"
-#include "events/flicker.h"
-#include "events/frame_effects.h"
-#include "events/simulator.h"
-#include "io/aedat4.h"
-#include "io/data_source.h"
-#include "io/frame_list.h"
-#include "io/hdf5_io.h"
-#include "io/output_target.h"
-#include "io/text_folder.h"
-#include "scene/scene.h"
+#include "evfs/app/calibrate_job.h"
+#include "evfs/app/demo.h"
+#include "evfs/app/denoise_job.h"
+#include "evfs/app/evfs_help.h"
+#include "evfs/app/evfs_options.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/app/reports.h"
+#include "evfs/app/run_report.h"
+#include "evfs/app/simulate_job.h"
+#include "evfs/app/version_report.h"
+#include "evfs/app/video_job.h"
+#include "evfs/app/video_mpi.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/core/version.h"
+#include "evfs/events/binning.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/frame_effects.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/io/output_target.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/runtime/allocator_tuning.h"
+#include "evfs/runtime/crash_guard.h"
+#include "evfs/runtime/progress.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 namespace {
@@ -333,7 +333,7 @@ int RunCommand(const std::string& command) {
   Require(std::isfinite(Options().Double("progress_interval_s")) &&
               Options().Double("progress_interval_s") >= 0.0,
           "--progress_interval_s must be a number of seconds, 0 or more");
-  // Lines on stderr while the command runs, only when it runs long (app/progress.h).
+  // Lines on stderr while the command runs, only when it runs long (runtime/progress.h).
   ProgressOptions progress_options;
   progress_options.prefix = "evfs " + command;
   progress_options.interval_s = Options().Double("progress_interval_s");
@@ -498,7 +498,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string command = argv[1];
-  // A failed CHECK is evfs' bug, not the user's: one line, status 3 (app/crash_guard.h).
+  // A failed CHECK is evfs' bug, not the user's: one line, status 3 (runtime/crash_guard.h).
   evfs::InstallInternalErrorReporting("evfs " + command);
   const auto run = [&command] {
     try {
@@ -528,7 +528,7 @@ int main(int argc, char** argv) {
   };
   // Every command runs in a worker process: a signal or a crash there leaves no unfinished
   // output (the parent removes it), and a corrupt .h5 file that crashes libhdf5 is a user error
-  // (app/crash_guard.h). `convert --overwrite` opens the .h5 file it would replace.
+  // (runtime/crash_guard.h). `convert --overwrite` opens the .h5 file it would replace.
   std::string hdf5_path;
   const evfs::OptionValues& options = evfs::Options();
   if (evfs::IsHdf5Path(options.String("data"))) {

@@ -10,12 +10,12 @@
 #include <exception>
 #include <string>
 
-#include "core/error.h"
-#include "core/time.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
-#include "scene/scene.h"
-#include "solver/reconstructor.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstructor.h"
 
 namespace {
 

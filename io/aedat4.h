@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "io/data_source.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

@@ -26,7 +26,7 @@
 #include <memory>
 #include <string>
 
-#include "io/data_source.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

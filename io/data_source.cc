@@ -1,4 +1,4 @@
-#include "io/data_source.h"
+#include "evfs/io/data_source.h"
 
 #include <algorithm>
 #include <cctype>
@@ -6,12 +6,12 @@
 #include <filesystem>
 #include <utility>
 
-#include "core/error.h"
-#include "io/aedat4.h"
-#include "io/aedat_legacy.h"
-#include "io/hdf5_io.h"
-#include "io/rosbag.h"
-#include "io/text_folder.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/io/aedat_legacy.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/io/rosbag.h"
+#include "evfs/io/text_folder.h"
 
 namespace evfs {
 

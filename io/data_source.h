@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/event_stream.h"
-#include "core/video.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

@@ -1,12 +1,12 @@
-#include "io/event_text.h"
+#include "evfs/io/event_text.h"
 
 #include <algorithm>
 #include <cstring>
 #include <utility>
 
-#include "io/decimal_seconds.h"
-#include "io/message_excerpt.h"
-#include "io/text_file_writer.h"
+#include "evfs/io/decimal_seconds.h"
+#include "evfs/io/message_excerpt.h"
+#include "evfs/io/text_file_writer.h"
 
 namespace evfs {
 namespace {

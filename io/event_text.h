@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <string>
 
-#include "core/error.h"
-#include "core/event_stream.h"
-#include "io/data_source.h"
-#include "io/mapped_file.h"
+#include "evfs/core/error.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/mapped_file.h"
 
 namespace evfs {
 

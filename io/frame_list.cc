@@ -1,4 +1,4 @@
-#include "io/frame_list.h"
+#include "evfs/io/frame_list.h"
 
 #include <atomic>
 #include <cerrno>
@@ -8,10 +8,10 @@
 #include <functional>
 #include <map>
 
-#include "core/error.h"
-#include "io/decimal_seconds.h"
-#include "io/message_excerpt.h"
-#include "io/text_file_writer.h"
+#include "evfs/core/error.h"
+#include "evfs/io/decimal_seconds.h"
+#include "evfs/io/message_excerpt.h"
+#include "evfs/io/text_file_writer.h"
 
 namespace evfs {
 namespace {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "io/data_source.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

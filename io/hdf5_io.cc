@@ -1,4 +1,4 @@
-#include "io/hdf5_io.h"
+#include "evfs/io/hdf5_io.h"
 
 #include <hdf5.h>
 
@@ -9,11 +9,11 @@
 #include <filesystem>
 #include <utility>
 
-#include "core/error.h"
-#include "core/time.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
-#include "io/message_excerpt.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/message_excerpt.h"
 
 namespace evfs {
 namespace {

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "core/input_library.h"
-#include "io/data_source.h"
+#include "evfs/core/input_library.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

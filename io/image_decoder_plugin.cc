@@ -1,5 +1,5 @@
 // The image decoder plug-in (io/image_decoder_plugin.h): OpenCV's imread behind a C interface.
-#include "io/image_decoder_plugin.h"
+#include "evfs/io/image_decoder_plugin.h"
 
 #include <cstdlib>
 #include <cstring>

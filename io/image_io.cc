@@ -1,4 +1,4 @@
-#include "io/image_io.h"
+#include "evfs/io/image_io.h"
 
 #include <unistd.h>
 
@@ -12,13 +12,13 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "core/error.h"
-#include "core/parallel.h"
-#include "core/plugin.h"
-#include "io/decimal_seconds.h"
-#include "io/image_decoder_plugin.h"
-#include "io/png_codec.h"
-#include "io/text_file_writer.h"
+#include "evfs/core/error.h"
+#include "evfs/core/parallel.h"
+#include "evfs/core/plugin.h"
+#include "evfs/io/decimal_seconds.h"
+#include "evfs/io/image_decoder_plugin.h"
+#include "evfs/io/png_codec.h"
+#include "evfs/io/text_file_writer.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "io/message_excerpt.h"
+#include "evfs/io/message_excerpt.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "io/output_target.h"
+#include "evfs/io/output_target.h"
 
 #include <fcntl.h>
 #include <pwd.h>
@@ -19,8 +19,8 @@
 #include <set>
 #include <sstream>
 
-#include "core/error.h"
-#include "io/signal_cleanup.h"
+#include "evfs/core/error.h"
+#include "evfs/runtime/signal_cleanup.h"
 
 namespace evfs {
 

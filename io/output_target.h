@@ -14,8 +14,8 @@
 // the same OUT removes such leftovers, and says so. A file output (an
 // .h5 file) is recognised by a predicate the caller gives (the HDF5 writer's own attribute).
 // Until Commit() the staging path is removed on every failure (the destructor) and when the
-// process dies (SIGINT, SIGTERM, SIGHUP, a crash: io/signal_cleanup.h); the earlier output stays
-// untouched until the new one is complete, and then one atomic rename swaps them.
+// process dies (SIGINT, SIGTERM, SIGHUP, a crash: runtime/signal_cleanup.h); the earlier output
+// stays untouched until the new one is complete, and then one atomic rename swaps them.
 #ifndef EVFS_IO_OUTPUT_TARGET_H_
 #define EVFS_IO_OUTPUT_TARGET_H_
 
@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "io/signal_cleanup.h"
+#include "evfs/runtime/signal_cleanup.h"
 
 namespace evfs {
 
@@ -67,8 +67,8 @@ struct OutputOptions {
 /// output, which holds the holder's process id: the kernel releases it when the process ends in
 /// any way (SIGKILL included), so a lock file left by a killed run never blocks; the holder
 /// removes the file when it lets go, and a worker process registers it for cleanup, so that its
-/// parent removes it when the worker dies (io/signal_cleanup.h). The lock file lies beside OUT,
-/// never inside it, so it is no part of an output.
+/// parent removes it when the worker dies (runtime/signal_cleanup.h). The lock file lies beside
+/// OUT, never inside it, so it is no part of an output.
 class OutputLock {
  public:
   /// Takes the lock on `out_path` without waiting: throws InvalidArgumentError, naming the output

@@ -1,4 +1,4 @@
-#include "io/png_codec.h"
+#include "evfs/io/png_codec.h"
 
 #include <png.h>
 #include <zlib.h>

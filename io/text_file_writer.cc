@@ -1,9 +1,9 @@
-#include "io/text_file_writer.h"
+#include "evfs/io/text_file_writer.h"
 
 #include <cerrno>
 #include <cstring>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 

@@ -1,12 +1,12 @@
-#include "io/text_folder.h"
+#include "evfs/io/text_folder.h"
 
 #include <cstdio>
 #include <filesystem>
 #include <utility>
 
-#include "core/error.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
+#include "evfs/core/error.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "io/data_source.h"
-#include "io/event_text.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/event_text.h"
 
 namespace evfs {
 

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <limits>
 
-#include "core/event_stream.h"
-#include "io/data_source.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

@@ -1,13 +1,13 @@
-#include "python/array_source.h"
+#include "evfs/python/array_source.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
-#include "core/error.h"
-#include "core/time.h"
-#include "io/image_io.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {

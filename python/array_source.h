@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "core/event_stream.h"
-#include "core/video.h"
-#include "io/data_source.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 

@@ -22,20 +22,20 @@
 #include <utility>
 #include <vector>
 
-#include "app/calibrate_job.h"
-#include "app/reconstruct_job.h"
-#include "app/video_job.h"
-#include "core/error.h"
-#include "core/event_stream.h"
-#include "core/time.h"
-#include "core/version.h"
-#include "core/video.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
-#include "io/output_target.h"
-#include "python/array_source.h"
-#include "python/reconstruct_options.h"
+#include "evfs/app/calibrate_job.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/app/video_job.h"
+#include "evfs/core/error.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/time.h"
+#include "evfs/core/version.h"
+#include "evfs/core/video.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/output_target.h"
+#include "evfs/python/array_source.h"
+#include "evfs/python/reconstruct_options.h"
 
 namespace evfs {
 namespace {

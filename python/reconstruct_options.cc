@@ -1,4 +1,4 @@
-#include "python/reconstruct_options.h"
+#include "evfs/python/reconstruct_options.h"
 
 #include <Python.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -9,7 +9,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "app/evfs_options.h"
+#include "evfs/app/evfs_options.h"
 
 namespace evfs {
 

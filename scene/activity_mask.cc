@@ -1,4 +1,4 @@
-#include "scene/activity_mask.h"
+#include "evfs/scene/activity_mask.h"
 
 #include <algorithm>
 #include <opencv2/imgproc.hpp>

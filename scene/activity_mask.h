@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/event_frames.h"
+#include "evfs/core/event_frames.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "scene/confidence.h"
+#include "evfs/scene/confidence.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "scene/exposure_blur.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/scene/exposure_blur.h"
 
 namespace evfs {
 namespace {

@@ -20,8 +20,8 @@
 
 #include <string>
 
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

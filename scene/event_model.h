@@ -11,8 +11,8 @@
 #include <cmath>
 #include <string>
 
-#include "core/enum_names.h"
-#include "core/option_checker.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/option_checker.h"
 
 namespace evfs {
 

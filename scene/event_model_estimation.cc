@@ -1,4 +1,4 @@
-#include "scene/event_model_estimation.h"
+#include "evfs/scene/event_model_estimation.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/option_checker.h"
+#include "evfs/core/option_checker.h"
 
 namespace evfs {
 namespace {

@@ -15,8 +15,8 @@
 
 #include <string>
 
-#include "scene/event_model.h"
-#include "scene/scene.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -1,14 +1,14 @@
-#include "scene/exposure_blur.h"
+#include "evfs/scene/exposure_blur.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "events/binning.h"
-#include "events/noise_filter.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/events/binning.h"
+#include "evfs/events/noise_filter.h"
 
 namespace evfs {
 

@@ -17,8 +17,8 @@
 #include <cstdint>
 #include <string>
 
-#include "core/event_stream.h"
-#include "core/video.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

@@ -1,14 +1,14 @@
-#include "scene/frame_timing.h"
+#include "evfs/scene/frame_timing.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "core/time.h"
-#include "scene/event_model.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
+#include "evfs/scene/event_model.h"
 
 namespace evfs {
 namespace {

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "core/enum_names.h"
-#include "core/event_stream.h"
-#include "core/video.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

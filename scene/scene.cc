@@ -1,13 +1,13 @@
-#include "scene/scene.h"
+#include "evfs/scene/scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <limits>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "events/noise_filter.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/events/noise_filter.h"
 
 namespace evfs {
 namespace {

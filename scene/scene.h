@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "core/enum_names.h"
-#include "core/event_frames.h"
-#include "core/event_stream.h"
-#include "core/video.h"
-#include "events/binning.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/event_frames.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
+#include "evfs/events/binning.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "solver/event_model_calibration.h"
+#include "evfs/solver/event_model_calibration.h"
 
 #include <ceres/ceres.h>
 
@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "cost_functions/event_count_residual.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/cost_functions/event_count_residual.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/first_order_solvers.h"
+#include "evfs/solver/first_order_solvers.h"
 
 #include <ceres/first_order_function.h>
 #include <ceres/gradient_problem.h>
@@ -11,10 +11,10 @@
 #include <memory>
 #include <vector>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "core/time.h"
-#include "solver/stop_callback.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
+#include "evfs/solver/stop_callback.h"
 
 namespace evfs {
 namespace {

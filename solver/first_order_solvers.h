@@ -21,13 +21,13 @@
 #include <cstdint>
 #include <string>
 
-#include "core/stop_condition.h"
-#include "core/video.h"
-#include "scene/activity_mask.h"
-#include "scene/scene.h"
-#include "solver/fused_objective.h"
-#include "solver/iteration_callback.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/core/stop_condition.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/fused_objective.h"
+#include "evfs/solver/iteration_callback.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 

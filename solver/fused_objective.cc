@@ -1,14 +1,14 @@
-#include "solver/fused_objective.h"
+#include "evfs/solver/fused_objective.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "cost_functions/weighted_l1_loss.h"
-#include "scene/event_model.h"
-#include "solver/objective_terms.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/cost_functions/weighted_l1_loss.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/solver/objective_terms.h"
 
 namespace evfs {
 namespace {

@@ -22,10 +22,10 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/activity_mask.h"
-#include "scene/scene.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 

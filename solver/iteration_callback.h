@@ -5,7 +5,7 @@
 
 #include <functional>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 

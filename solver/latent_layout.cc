@@ -1,10 +1,10 @@
-#include "solver/latent_layout.h"
+#include "evfs/solver/latent_layout.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

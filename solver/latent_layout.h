@@ -30,9 +30,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/activity_mask.h"
-#include "scene/scene.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -1,9 +1,9 @@
-#include "solver/objective_terms.h"
+#include "evfs/solver/objective_terms.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 

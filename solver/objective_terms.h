@@ -28,9 +28,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "scene/activity_mask.h"
-#include "scene/scene.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "solver/problem_builder.h"
+#include "evfs/solver/problem_builder.h"
 
 #include <algorithm>
 #include <functional>
@@ -6,15 +6,15 @@
 #include <tuple>
 #include <utility>
 
-#include "core/error.h"
-#include "core/parallel.h"
-#include "cost_functions/difference_residual.h"
-#include "cost_functions/event_residual.h"
-#include "cost_functions/frame_residual.h"
-#include "cost_functions/prior_residual.h"
-#include "cost_functions/spatial_tv_residual.h"
-#include "cost_functions/weighted_l1_loss.h"
-#include "solver/objective_terms.h"
+#include "evfs/core/error.h"
+#include "evfs/core/parallel.h"
+#include "evfs/cost_functions/difference_residual.h"
+#include "evfs/cost_functions/event_residual.h"
+#include "evfs/cost_functions/frame_residual.h"
+#include "evfs/cost_functions/prior_residual.h"
+#include "evfs/cost_functions/spatial_tv_residual.h"
+#include "evfs/cost_functions/weighted_l1_loss.h"
+#include "evfs/solver/objective_terms.h"
 
 namespace evfs {
 namespace {

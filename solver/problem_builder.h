@@ -11,12 +11,12 @@
 #include <utility>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/activity_mask.h"
-#include "scene/scene.h"
-#include "solver/latent_layout.h"
-#include "solver/objective_terms.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/latent_layout.h"
+#include "evfs/solver/objective_terms.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 

@@ -1,8 +1,8 @@
-#include "solver/reconstruction_options.h"
+#include "evfs/solver/reconstruction_options.h"
 
 #include <cmath>
 
-#include "core/option_checker.h"
+#include "evfs/core/option_checker.h"
 
 namespace evfs {
 namespace {

@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "core/enum_names.h"
-#include "core/stop_condition.h"
-#include "core/video.h"
-#include "cost_functions/spatial_tv_residual.h"
-#include "scene/event_model.h"
-#include "scene/event_model_estimation.h"
+#include "evfs/core/enum_names.h"
+#include "evfs/core/stop_condition.h"
+#include "evfs/core/video.h"
+#include "evfs/cost_functions/spatial_tv_residual.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/scene/event_model_estimation.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "solver/reconstructor.h"
+#include "evfs/solver/reconstructor.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,11 +8,11 @@
 #include <sstream>
 #include <vector>
 
-#include "core/error.h"
-#include "core/parallel.h"
-#include "core/time.h"
-#include "solver/step_ramps.h"
-#include "solver/stop_callback.h"
+#include "evfs/core/error.h"
+#include "evfs/core/parallel.h"
+#include "evfs/core/time.h"
+#include "evfs/solver/step_ramps.h"
+#include "evfs/solver/stop_callback.h"
 
 namespace evfs {
 namespace {

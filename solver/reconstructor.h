@@ -6,12 +6,12 @@
 
 #include <string>
 
-#include "core/video.h"
-#include "scene/event_model_estimation.h"
-#include "scene/scene.h"
-#include "solver/iteration_callback.h"
-#include "solver/problem_builder.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/iteration_callback.h"
+#include "evfs/solver/problem_builder.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 

@@ -1,11 +1,11 @@
-#include "solver/sharp_frame_seams.h"
+#include "evfs/solver/sharp_frame_seams.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 

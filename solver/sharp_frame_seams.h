@@ -21,8 +21,8 @@
 #ifndef EVFS_SOLVER_SHARP_FRAME_SEAMS_H_
 #define EVFS_SOLVER_SHARP_FRAME_SEAMS_H_
 
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -1,4 +1,4 @@
-#include "solver/step_ramps.h"
+#include "evfs/solver/step_ramps.h"
 
 #include <algorithm>
 #include <cmath>

@@ -35,9 +35,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/scene.h"
-#include "solver/latent_layout.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/latent_layout.h"
 
 namespace evfs {
 

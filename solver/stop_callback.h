@@ -5,7 +5,7 @@
 
 #include <ceres/iteration_callback.h>
 
-#include "core/stop_condition.h"
+#include "evfs/core/stop_condition.h"
 
 namespace evfs {
 

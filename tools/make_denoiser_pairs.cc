@@ -47,20 +47,20 @@
 #include <string>
 #include <vector>
 
-#include "app/method.h"
-#include "core/error.h"
-#include "core/metrics.h"
-#include "core/option_checker.h"
-#include "core/time.h"
-#include "events/flicker.h"
-#include "events/frame_effects.h"
-#include "events/random.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
-#include "io/output_target.h"
-#include "scene/scene.h"
+#include "evfs/app/method.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/core/time.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/frame_effects.h"
+#include "evfs/events/random.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/output_target.h"
+#include "evfs/scene/scene.h"
 
 DEFINE_string(out, "", "Output folder: a new one, or an earlier output with --overwrite.");
 DEFINE_bool(overwrite, false, "Replace --out when it is an earlier output of this tool.");

@@ -1,4 +1,4 @@
-#include "io/aedat4/decompressor.h"
+#include "evfs/io/aedat4/decompressor.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/aedat4/format.h"
+#include "evfs/io/aedat4/format.h"
 
 namespace evfs {
 namespace aedat4 {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "io/aedat4.h"
+#include "evfs/io/aedat4.h"
 
 namespace evfs {
 namespace aedat4 {

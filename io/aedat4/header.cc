@@ -1,4 +1,4 @@
-#include "io/aedat4/header.h"
+#include "evfs/io/aedat4/header.h"
 
 #include <tinyxml2.h>
 
@@ -10,11 +10,11 @@
 #include <set>
 #include <utility>
 
-#include "core/error.h"
-#include "io/aedat4/format.h"
-#include "io/aedat4/io_header_generated.h"
-#include "io/image_io.h"
-#include "io/message_excerpt.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat4/format.h"
+#include "evfs/io/aedat4/io_header_generated.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/message_excerpt.h"
 
 namespace evfs {
 namespace aedat4 {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "io/aedat4.h"
-#include "io/data_source.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 namespace aedat4 {

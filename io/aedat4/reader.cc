@@ -12,17 +12,17 @@
 #include <set>
 #include <utility>
 
-#include "core/error.h"
-#include "io/aedat4.h"
-#include "io/aedat4/decompressor.h"
-#include "io/aedat4/events_generated.h"
-#include "io/aedat4/file_data_table_generated.h"
-#include "io/aedat4/format.h"
-#include "io/aedat4/frame_generated.h"
-#include "io/aedat4/header.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
-#include "io/mapped_file.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/io/aedat4/decompressor.h"
+#include "evfs/io/aedat4/events_generated.h"
+#include "evfs/io/aedat4/file_data_table_generated.h"
+#include "evfs/io/aedat4/format.h"
+#include "evfs/io/aedat4/frame_generated.h"
+#include "evfs/io/aedat4/header.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/mapped_file.h"
 
 namespace evfs {
 namespace {

@@ -13,15 +13,15 @@
 #include <stdexcept>
 #include <utility>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "io/aedat4.h"
-#include "io/aedat4/events_generated.h"
-#include "io/aedat4/file_data_table_generated.h"
-#include "io/aedat4/format.h"
-#include "io/aedat4/frame_generated.h"
-#include "io/aedat4/header.h"
-#include "io/image_io.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/io/aedat4/events_generated.h"
+#include "evfs/io/aedat4/file_data_table_generated.h"
+#include "evfs/io/aedat4/format.h"
+#include "evfs/io/aedat4/frame_generated.h"
+#include "evfs/io/aedat4/header.h"
+#include "evfs/io/image_io.h"
 
 namespace evfs {
 namespace {

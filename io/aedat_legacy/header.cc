@@ -1,11 +1,11 @@
-#include "io/aedat_legacy/header.h"
+#include "evfs/io/aedat_legacy/header.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cstring>
 
-#include "core/error.h"
-#include "io/aedat_legacy/format.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat_legacy/format.h"
 
 namespace evfs {
 namespace aedat_legacy {

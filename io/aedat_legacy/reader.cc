@@ -11,12 +11,12 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "io/aedat_legacy.h"
-#include "io/aedat_legacy/format.h"
-#include "io/aedat_legacy/header.h"
-#include "io/mapped_file.h"
-#include "io/visited_events.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat_legacy.h"
+#include "evfs/io/aedat_legacy/format.h"
+#include "evfs/io/aedat_legacy/header.h"
+#include "evfs/io/mapped_file.h"
+#include "evfs/io/visited_events.h"
 
 namespace evfs {
 namespace aedat_legacy {

@@ -1,4 +1,4 @@
-#include "io/rosbag/format.h"
+#include "evfs/io/rosbag/format.h"
 
 #include <bzlib.h>
 #include <roslz4/lz4s.h>
@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "io/message_excerpt.h"
+#include "evfs/core/error.h"
+#include "evfs/io/message_excerpt.h"
 
 namespace evfs {
 namespace rosbag_format {

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 namespace rosbag_format {

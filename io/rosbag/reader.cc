@@ -21,12 +21,12 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "io/mapped_file.h"
-#include "io/message_excerpt.h"
-#include "io/rosbag.h"
-#include "io/rosbag/format.h"
-#include "io/visited_events.h"
+#include "evfs/core/error.h"
+#include "evfs/io/mapped_file.h"
+#include "evfs/io/message_excerpt.h"
+#include "evfs/io/rosbag.h"
+#include "evfs/io/rosbag/format.h"
+#include "evfs/io/visited_events.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "app/allocator_tuning.h"
+#include "evfs/runtime/allocator_tuning.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>

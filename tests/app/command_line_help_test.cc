@@ -1,4 +1,4 @@
-#include "app/command_line_help.h"
+#include "evfs/app/command_line_help.h"
 
 #include <gflags/gflags.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 // The flags of a small program, "tool", defined in this file like evfs' in evfs_main.cc.
 DEFINE_string(help_test_path, "", "Where the tool reads from.");

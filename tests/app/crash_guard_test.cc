@@ -1,4 +1,4 @@
-#include "app/crash_guard.h"
+#include "evfs/runtime/crash_guard.h"
 
 #include <glog/logging.h>
 #include <gtest/gtest.h>
@@ -11,10 +11,10 @@
 #include <string>
 #include <thread>
 
-#include "core/error.h"
-#include "io/hdf5_io.h"
-#include "io/signal_cleanup.h"
-#include "tests/test_data.h"
+#include "evfs/core/error.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/runtime/signal_cleanup.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

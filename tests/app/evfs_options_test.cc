@@ -1,6 +1,6 @@
 // The option table of evfs (app/evfs_options.h): one row per flag, and every consumer — the
 // command line's flags, --help, Python's keys, the requests, video's fingerprint — made from it.
-#include "app/evfs_options.h"
+#include "evfs/app/evfs_options.h"
 
 #include <gflags/gflags.h>
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "app/command_line_help.h"
-#include "app/evfs_help.h"
+#include "evfs/app/command_line_help.h"
+#include "evfs/app/evfs_help.h"
 
 namespace evfs {
 namespace {

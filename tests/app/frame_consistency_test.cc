@@ -1,13 +1,13 @@
-#include "app/frame_consistency.h"
+#include "evfs/denoiser/frame_consistency.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <vector>
 
-#include "core/error.h"
-#include "scene/scene.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/scene/scene.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {

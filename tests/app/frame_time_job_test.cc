@@ -4,9 +4,9 @@
 
 #include <filesystem>
 
-#include "app/reconstruct_job.h"
-#include "core/error.h"
-#include "tests/test_data.h"
+#include "evfs/app/reconstruct_job.h"
+#include "evfs/core/error.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-// Mp4Writer (app/video_writer.h): the same frames make the same file, whichever CPUs the writing
+// Mp4Writer (io/video_writer.h): the same frames make the same file, whichever CPUs the writing
 // thread may use and whatever the process did before, so that `evfs video` from one process,
 // from rank 0 of `mpirun` (bound to a core) and after --resume writes the same video.mp4.
 #include <gtest/gtest.h>
@@ -14,9 +14,9 @@
 #include <thread>
 #include <vector>
 
-#include "app/video_writer.h"
-#include "core/video.h"
-#include "tests/test_data.h"
+#include "evfs/core/video.h"
+#include "evfs/io/video_writer.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "app/progress.h"
+#include "evfs/runtime/progress.h"
 
 #include <gtest/gtest.h>
 

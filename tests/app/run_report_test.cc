@@ -1,10 +1,10 @@
-#include "app/run_report.h"
+#include "evfs/app/run_report.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "app/version_report.h"
+#include "evfs/app/version_report.h"
 
 #include <ceres/version.h>
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <opencv2/core/version.hpp>
 #include <string>
 
-#include "core/version.h"
+#include "evfs/core/version.h"
 
 namespace evfs {
 namespace {

@@ -1,10 +1,10 @@
-#include "app/video_windows.h"
+#include "evfs/app/video_windows.h"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "baselines/baseline.h"
+#include "evfs/baselines/baseline.h"
 
 #include <gtest/gtest.h>
 
@@ -10,15 +10,15 @@
 #include <string>
 #include <vector>
 
-#include "baselines/complementary_filter.h"
-#include "baselines/event_double_integral.h"
-#include "baselines/event_integration.h"
-#include "core/error.h"
-#include "io/data_source.h"
-#include "scene/event_model_estimation.h"
-#include "scene/scene.h"
-#include "tests/baselines/baseline_test_scenes.h"
-#include "tests/test_data.h"
+#include "evfs/baselines/complementary_filter.h"
+#include "evfs/baselines/event_double_integral.h"
+#include "evfs/baselines/event_integration.h"
+#include "evfs/core/error.h"
+#include "evfs/io/data_source.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/scene/scene.h"
+#include "evfs/tests/baselines/baseline_test_scenes.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

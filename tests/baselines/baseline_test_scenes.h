@@ -2,10 +2,10 @@
 #ifndef EVFS_TESTS_BASELINES_BASELINE_TEST_SCENES_H_
 #define EVFS_TESTS_BASELINES_BASELINE_TEST_SCENES_H_
 
-#include "core/metrics.h"
-#include "core/video.h"
-#include "scene/scene.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace test {

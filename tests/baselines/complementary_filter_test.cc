@@ -1,14 +1,14 @@
-#include "baselines/complementary_filter.h"
+#include "evfs/baselines/complementary_filter.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "baselines/event_integration.h"
-#include "core/error.h"
-#include "scene/scene.h"
-#include "tests/baselines/baseline_test_scenes.h"
+#include "evfs/baselines/event_integration.h"
+#include "evfs/core/error.h"
+#include "evfs/scene/scene.h"
+#include "evfs/tests/baselines/baseline_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "baselines/event_double_integral.h"
+#include "evfs/baselines/event_double_integral.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "baselines/baseline.h"
-#include "core/error.h"
-#include "tests/baselines/baseline_test_scenes.h"
+#include "evfs/baselines/baseline.h"
+#include "evfs/core/error.h"
+#include "evfs/tests/baselines/baseline_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,14 +1,14 @@
-#include "baselines/event_integration.h"
+#include "evfs/baselines/event_integration.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-#include "core/error.h"
-#include "events/simulator.h"
-#include "scene/scene.h"
-#include "tests/baselines/baseline_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/events/simulator.h"
+#include "evfs/scene/scene.h"
+#include "evfs/tests/baselines/baseline_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "baselines/scalar_search.h"
+#include "evfs/baselines/scalar_search.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "benchmarks/cell_runner.h"
+#include "evfs/benchmarks/cell_runner.h"
 
 #include <gtest/gtest.h>
 

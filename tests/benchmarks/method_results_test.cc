@@ -1,4 +1,4 @@
-#include "benchmarks/method_results.h"
+#include "evfs/benchmarks/method_results.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-#include "core/enum_names.h"
+#include "evfs/core/enum_names.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

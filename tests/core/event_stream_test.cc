@@ -1,8 +1,8 @@
-#include "core/event_stream.h"
+#include "evfs/core/event_stream.h"
 
 #include <gtest/gtest.h>
 
-#include "core/event_frames.h"
+#include "evfs/core/event_frames.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/option_checker.h"
+#include "evfs/core/option_checker.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "core/parallel.h"
+#include "evfs/core/parallel.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>

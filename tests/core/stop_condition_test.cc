@@ -1,4 +1,4 @@
-#include "core/stop_condition.h"
+#include "evfs/core/stop_condition.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 #include <gtest/gtest.h>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -1,11 +1,11 @@
-#include "cost_functions/difference_residual.h"
+#include "evfs/cost_functions/difference_residual.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <random>
 
-#include "tests/cost_functions/cost_function_testing.h"
+#include "evfs/tests/cost_functions/cost_function_testing.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "cost_functions/event_count_residual.h"
+#include "evfs/cost_functions/event_count_residual.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <memory>
 #include <random>
 
-#include "tests/cost_functions/cost_function_testing.h"
+#include "evfs/tests/cost_functions/cost_function_testing.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "cost_functions/event_residual.h"
+#include "evfs/cost_functions/event_residual.h"
 
 #include <ceres/autodiff_cost_function.h>
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/cost_functions/cost_function_testing.h"
+#include "evfs/tests/cost_functions/cost_function_testing.h"
 
 namespace evfs {
 namespace {

@@ -1,11 +1,11 @@
-#include "cost_functions/scalar_parameter_blocks.h"
+#include "evfs/cost_functions/scalar_parameter_blocks.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <vector>
 
-#include "tests/cost_functions/cost_function_testing.h"
+#include "evfs/tests/cost_functions/cost_function_testing.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "cost_functions/spatial_tv_residual.h"
+#include "evfs/cost_functions/spatial_tv_residual.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "tests/cost_functions/cost_function_testing.h"
+#include "evfs/tests/cost_functions/cost_function_testing.h"
 
 namespace evfs {
 namespace {

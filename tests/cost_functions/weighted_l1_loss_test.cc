@@ -1,4 +1,4 @@
-#include "cost_functions/weighted_l1_loss.h"
+#include "evfs/cost_functions/weighted_l1_loss.h"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "denoiser/denoiser.h"
+#include "evfs/denoiser/denoiser.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -14,9 +14,9 @@
 #include <string>
 #include <thread>
 
-#include "core/error.h"
-#include "denoiser/sha256.h"
-#include "tests/test_data.h"
+#include "evfs/core/error.h"
+#include "evfs/denoiser/sha256.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "events/binning.h"
+#include "evfs/events/binning.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "events/random.h"
+#include "evfs/core/error.h"
+#include "evfs/events/random.h"
 
 namespace evfs {
 namespace {

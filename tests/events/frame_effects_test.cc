@@ -1,4 +1,4 @@
-#include "events/frame_effects.h"
+#include "evfs/events/frame_effects.h"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "core/time.h"
-#include "events/flicker.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/events/flicker.h"
 
 namespace evfs {
 namespace {

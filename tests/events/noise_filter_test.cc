@@ -1,4 +1,4 @@
-#include "events/noise_filter.h"
+#include "evfs/events/noise_filter.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <tuple>
 #include <vector>
 
-#include "events/random.h"
+#include "evfs/events/random.h"
 
 namespace evfs {
 namespace {

@@ -1,12 +1,12 @@
-#include "events/scene_synthesizer.h"
+#include "evfs/events/scene_synthesizer.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "core/error.h"
-#include "core/time.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "events/simulator.h"
+#include "evfs/events/simulator.h"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "core/time.h"
-#include "events/flicker.h"
-#include "events/scene_synthesizer.h"
+#include "evfs/core/error.h"
+#include "evfs/core/time.h"
+#include "evfs/events/flicker.h"
+#include "evfs/events/scene_synthesizer.h"
 
 namespace evfs {
 namespace {

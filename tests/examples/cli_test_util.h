@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/text_folder.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/text_folder.h"
 
 namespace evfs {
 namespace test {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/examples/cli_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

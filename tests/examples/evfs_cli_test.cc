@@ -10,15 +10,15 @@
 #include <sstream>
 #include <string>
 
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "io/hdf5_io.h"
-#include "io/image_io.h"
-#include "io/text_folder.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {
@@ -351,7 +351,7 @@ TEST(EvfsCli, Aedat31ReconstructsLikeItsFolderAndBadAedatIsAUserError) {
 
 // Two files the HDF5 fuzzer found on which libhdf5 1.10 itself dies of a segmentation fault
 // (in H5AC_protect's block read, and in H5Aexists). The CLI runs HDF5 commands in a child
-// process (app/crash_guard.h), so they end as a user error, not as a crash. Whether libhdf5
+// process (runtime/crash_guard.h), so they end as a user error, not as a crash. Whether libhdf5
 // dies or reads garbage past the corruption depends on what its heap held (one CI run in many
 // read an exposure that ends before it starts instead): either way, one line naming the file.
 TEST(EvfsCli, Hdf5FileThatCrashesLibhdf5IsAUserError) {

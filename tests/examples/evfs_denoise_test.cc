@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "denoiser/sha256.h"
-#include "io/image_io.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/denoiser/sha256.h"
+#include "evfs/io/image_io.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace test {

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/image_io.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {
@@ -235,7 +235,7 @@ TEST(EvfsFailure, MissingFrameListIsNamed) {
                   h5.string() + " has 0 frames (", out);
 }
 
-// Progress lines (app/progress.h) look like
+// Progress lines (runtime/progress.h) look like
 //   evfs reconstruct: 0.0 s elapsed             (before the job names its first stage)
 //   evfs reconstruct: build and solve, 0.1 s elapsed
 //   evfs reconstruct: solve, iteration 3 (cost 1.234567e-01), 0.2 s elapsed

@@ -1,14 +1,14 @@
 // `evfs --help`, `evfs COMMAND --help` and `evfs --version`, run as a user runs them.
-#include "app/evfs_help.h"
+#include "evfs/app/evfs_help.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "app/command_line_help.h"
-#include "app/version_report.h"
-#include "core/version.h"
-#include "tests/examples/cli_test_util.h"
+#include "evfs/app/command_line_help.h"
+#include "evfs/app/version_report.h"
+#include "evfs/core/version.h"
+#include "evfs/tests/examples/cli_test_util.h"
 
 namespace evfs {
 namespace {

@@ -11,12 +11,12 @@
 #include <tuple>
 #include <vector>
 
-#include "io/data_source.h"
-#include "io/hdf5_io.h"
-#include "io/text_folder.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/hdf5_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/hdf5_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -13,10 +13,10 @@
 #include <thread>
 #include <vector>
 
-#include "io/output_target.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/output_target.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -10,9 +10,9 @@
 #include <fstream>
 #include <string>
 
-#include "io/data_source.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/data_source.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -17,12 +17,12 @@
 #include <thread>
 #include <vector>
 
-#include "core/video.h"
-#include "io/data_source.h"
-#include "io/image_io.h"
-#include "tests/examples/cli_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/core/video.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/image_io.h"
+#include "evfs/tests/examples/cli_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

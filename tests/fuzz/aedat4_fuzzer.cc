@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "io/aedat4.h"
-#include "tests/fuzz/fuzz_util.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/tests/fuzz/fuzz_util.h"
 
 namespace evfs {
 namespace fuzzing {

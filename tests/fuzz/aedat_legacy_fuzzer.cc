@@ -9,9 +9,9 @@
 #include <cstdint>
 #include <string>
 
-#include "core/error.h"
-#include "io/aedat_legacy.h"
-#include "tests/fuzz/fuzz_util.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat_legacy.h"
+#include "evfs/tests/fuzz/fuzz_util.h"
 
 namespace evfs {
 namespace fuzzing {

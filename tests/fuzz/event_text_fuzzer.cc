@@ -9,10 +9,10 @@
 #include <string>
 #include <utility>
 
-#include "core/error.h"
-#include "io/event_text.h"
-#include "io/mapped_file.h"
-#include "tests/fuzz/fuzz_util.h"
+#include "evfs/core/error.h"
+#include "evfs/io/event_text.h"
+#include "evfs/io/mapped_file.h"
+#include "evfs/tests/fuzz/fuzz_util.h"
 
 namespace evfs {
 namespace fuzzing {

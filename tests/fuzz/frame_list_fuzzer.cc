@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "io/frame_list.h"
-#include "tests/fuzz/fuzz_util.h"
+#include "evfs/core/error.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/tests/fuzz/fuzz_util.h"
 
 namespace evfs {
 namespace fuzzing {

@@ -31,13 +31,13 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "io/aedat4.h"
-#include "io/data_source.h"
-#include "io/event_text.h"
-#include "io/frame_list.h"
-#include "io/image_io.h"
-#include "io/text_folder.h"
+#include "evfs/core/error.h"
+#include "evfs/io/aedat4.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/event_text.h"
+#include "evfs/io/frame_list.h"
+#include "evfs/io/image_io.h"
+#include "evfs/io/text_folder.h"
 
 namespace evfs {
 namespace {

@@ -13,8 +13,8 @@
 #include <filesystem>
 #include <string>
 
-#include "core/error.h"
-#include "io/data_source.h"
+#include "evfs/core/error.h"
+#include "evfs/io/data_source.h"
 
 namespace evfs {
 namespace fuzzing {

@@ -12,9 +12,9 @@
 #include <cstring>
 #include <string>
 
-#include "core/error.h"
-#include "io/rosbag/format.h"
-#include "tests/fuzz/fuzz_util.h"
+#include "evfs/core/error.h"
+#include "evfs/io/rosbag/format.h"
+#include "evfs/tests/fuzz/fuzz_util.h"
 
 namespace evfs {
 namespace fuzzing {

@@ -1,4 +1,4 @@
-#include "io/aedat4.h"
+#include "evfs/io/aedat4.h"
 
 #include <flatbuffers/flatbuffers.h>
 #include <gtest/gtest.h>
@@ -20,11 +20,11 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "io/data_source.h"
-#include "io/text_folder.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/core/error.h"
+#include "evfs/io/data_source.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

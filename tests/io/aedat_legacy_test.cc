@@ -1,4 +1,4 @@
-#include "io/aedat_legacy.h"
+#include "evfs/io/aedat_legacy.h"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "io/aedat_legacy/format.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/aedat_legacy/format.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

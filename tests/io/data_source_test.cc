@@ -1,4 +1,4 @@
-#include "io/data_source.h"
+#include "evfs/io/data_source.h"
 
 #include <gtest/gtest.h>
 
@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "io/hdf5_io.h"
-#include "io/text_folder.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/hdf5_io.h"
+#include "evfs/io/text_folder.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

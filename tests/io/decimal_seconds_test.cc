@@ -1,4 +1,4 @@
-#include "io/decimal_seconds.h"
+#include "evfs/io/decimal_seconds.h"
 
 #include <gtest/gtest.h>
 

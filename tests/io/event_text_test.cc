@@ -1,4 +1,4 @@
-#include "io/event_text.h"
+#include "evfs/io/event_text.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "io/decimal_seconds.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/decimal_seconds.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

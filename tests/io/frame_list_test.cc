@@ -1,4 +1,4 @@
-#include "io/frame_list.h"
+#include "evfs/io/frame_list.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

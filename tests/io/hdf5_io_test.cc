@@ -1,4 +1,4 @@
-#include "io/hdf5_io.h"
+#include "evfs/io/hdf5_io.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -8,9 +8,9 @@
 #include <thread>
 #include <vector>
 
-#include "tests/io/hdf5_test_util.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/tests/io/hdf5_test_util.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "io/image_io.h"
+#include "evfs/io/image_io.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

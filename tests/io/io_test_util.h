@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "core/event_stream.h"
-#include "core/video.h"
+#include "evfs/core/error.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 namespace test {

@@ -1,4 +1,4 @@
-#include "io/mapped_file.h"
+#include "evfs/io/mapped_file.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <string>
 #include <utility>
 
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,7 +1,7 @@
 // OutputTarget and signal cleanup: what an output may replace, and that nothing else is ever
 // touched. Every case runs in a sandbox folder of its own; the root, home and current folders
 // are stand-ins inside it.
-#include "io/output_target.h"
+#include "evfs/io/output_target.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -16,10 +16,10 @@
 #include <thread>
 #include <vector>
 
-#include "core/error.h"
-#include "io/signal_cleanup.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/core/error.h"
+#include "evfs/runtime/signal_cleanup.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

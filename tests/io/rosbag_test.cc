@@ -1,4 +1,4 @@
-#include "io/rosbag.h"
+#include "evfs/io/rosbag.h"
 
 #include <gtest/gtest.h>
 
@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "io/rosbag/format.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/core/error.h"
+#include "evfs/io/rosbag/format.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

@@ -1,11 +1,11 @@
-#include "io/text_file_writer.h"
+#include "evfs/io/text_file_writer.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

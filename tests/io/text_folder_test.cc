@@ -1,4 +1,4 @@
-#include "io/text_folder.h"
+#include "evfs/io/text_folder.h"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
-#include "tests/io/io_test_util.h"
-#include "tests/test_data.h"
+#include "evfs/io/image_io.h"
+#include "evfs/tests/io/io_test_util.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

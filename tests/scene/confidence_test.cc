@@ -1,4 +1,4 @@
-#include "scene/confidence.h"
+#include "evfs/scene/confidence.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -1,11 +1,11 @@
-#include "scene/event_model_estimation.h"
+#include "evfs/scene/event_model_estimation.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "events/simulator.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/events/simulator.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {

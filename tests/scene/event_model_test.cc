@@ -1,4 +1,4 @@
-#include "scene/event_model.h"
+#include "evfs/scene/event_model.h"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "scene/exposure_blur.h"
+#include "evfs/scene/exposure_blur.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string>
 
-#include "core/error.h"
-#include "events/random.h"
+#include "evfs/core/error.h"
+#include "evfs/events/random.h"
 
 namespace evfs {
 namespace {

@@ -1,12 +1,12 @@
-#include "scene/frame_timing.h"
+#include "evfs/scene/frame_timing.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <utility>
 
-#include "core/error.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "scene/scene.h"
+#include "evfs/scene/scene.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 #if defined(__has_feature)
 #define EVFS_HAS_FEATURE(x) __has_feature(x)

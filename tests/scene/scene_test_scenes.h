@@ -2,12 +2,12 @@
 #ifndef EVFS_TESTS_SCENE_SCENE_TEST_SCENES_H_
 #define EVFS_TESTS_SCENE_SCENE_TEST_SCENES_H_
 
-#include "core/event_stream.h"
-#include "core/time.h"
-#include "core/video.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "scene/scene.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/time.h"
+#include "evfs/core/video.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 namespace test {

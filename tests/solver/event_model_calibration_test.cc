@@ -1,4 +1,4 @@
-#include "solver/event_model_calibration.h"
+#include "evfs/solver/event_model_calibration.h"
 
 #include <gtest/gtest.h>
 
@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "io/data_source.h"
-#include "tests/test_data.h"
+#include "evfs/core/error.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/io/data_source.h"
+#include "evfs/tests/test_data.h"
 
 namespace evfs {
 namespace {

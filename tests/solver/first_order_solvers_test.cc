@@ -1,4 +1,4 @@
-#include "solver/first_order_solvers.h"
+#include "evfs/solver/first_order_solvers.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "scene/event_model_estimation.h"
-#include "solver/problem_builder.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/solver/problem_builder.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace {

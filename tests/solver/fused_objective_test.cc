@@ -1,4 +1,4 @@
-#include "solver/fused_objective.h"
+#include "evfs/solver/fused_objective.h"
 
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
@@ -11,10 +11,10 @@
 #include <tuple>
 #include <vector>
 
-#include "core/error.h"
-#include "scene/activity_mask.h"
-#include "solver/objective_terms.h"
-#include "solver/problem_builder.h"
+#include "evfs/core/error.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/solver/objective_terms.h"
+#include "evfs/solver/problem_builder.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/objective_terms.h"
+#include "evfs/solver/objective_terms.h"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "scene/activity_mask.h"
-#include "solver/problem_builder.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/solver/problem_builder.h"
+#include "evfs/tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/problem_builder.h"
+#include "evfs/solver/problem_builder.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <limits>
 #include <vector>
 
-#include "tests/scene/scene_test_scenes.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
+#include "evfs/tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/reconstructor.h"
+#include "evfs/solver/reconstructor.h"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "scene/activity_mask.h"
-#include "tests/scene/scene_test_scenes.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
+#include "evfs/tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/sharp_frame_seams.h"
+#include "evfs/solver/sharp_frame_seams.h"
 
 #include <gtest/gtest.h>
 
@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <vector>
 
-#include "core/error.h"
-#include "core/metrics.h"
-#include "solver/reconstructor.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/core/metrics.h"
+#include "evfs/solver/reconstructor.h"
+#include "evfs/tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "scene/scene.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 

@@ -1,13 +1,13 @@
-#include "solver/step_ramps.h"
+#include "evfs/solver/step_ramps.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-#include "core/metrics.h"
-#include "solver/reconstructor.h"
-#include "tests/solver/solver_test_scenes.h"
+#include "evfs/core/metrics.h"
+#include "evfs/solver/reconstructor.h"
+#include "evfs/tests/solver/solver_test_scenes.h"
 
 namespace evfs {
 namespace {

@@ -6,9 +6,9 @@
 #include <string>
 #include <tuple>
 
-#include "core/error.h"
-#include "tests/stress/stress_checks.h"
-#include "tests/stress/stress_scenes.h"
+#include "evfs/core/error.h"
+#include "evfs/tests/stress/stress_checks.h"
+#include "evfs/tests/stress/stress_scenes.h"
 
 namespace evfs {
 namespace {

@@ -10,10 +10,10 @@
 #include <tuple>
 #include <utility>
 
-#include "baselines/baseline.h"
-#include "core/error.h"
-#include "tests/stress/stress_checks.h"
-#include "tests/stress/stress_scenes.h"
+#include "evfs/baselines/baseline.h"
+#include "evfs/core/error.h"
+#include "evfs/tests/stress/stress_checks.h"
+#include "evfs/tests/stress/stress_scenes.h"
 
 namespace evfs {
 namespace {

@@ -7,12 +7,12 @@
 #include <string>
 #include <tuple>
 
-#include "scene/activity_mask.h"
-#include "scene/event_model_estimation.h"
-#include "solver/first_order_solvers.h"
-#include "solver/fused_objective.h"
-#include "tests/stress/stress_checks.h"
-#include "tests/stress/stress_scenes.h"
+#include "evfs/scene/activity_mask.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/solver/first_order_solvers.h"
+#include "evfs/solver/fused_objective.h"
+#include "evfs/tests/stress/stress_checks.h"
+#include "evfs/tests/stress/stress_scenes.h"
 
 namespace evfs {
 namespace {

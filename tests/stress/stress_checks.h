@@ -14,13 +14,13 @@
 #include <string>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/event_model_estimation.h"
-#include "solver/latent_layout.h"
-#include "solver/problem_builder.h"
-#include "solver/reconstruction_options.h"
-#include "solver/reconstructor.h"
-#include "tests/stress/stress_scenes.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/event_model_estimation.h"
+#include "evfs/solver/latent_layout.h"
+#include "evfs/solver/problem_builder.h"
+#include "evfs/solver/reconstruction_options.h"
+#include "evfs/solver/reconstructor.h"
+#include "evfs/tests/stress/stress_scenes.h"
 
 namespace evfs {
 namespace test {

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "core/event_stream.h"
-#include "core/video.h"
-#include "events/random.h"
-#include "scene/event_model.h"
-#include "scene/scene.h"
-#include "tests/scene/scene_test_scenes.h"
+#include "evfs/core/event_stream.h"
+#include "evfs/core/video.h"
+#include "evfs/events/random.h"
+#include "evfs/scene/event_model.h"
+#include "evfs/scene/scene.h"
+#include "evfs/tests/scene/scene_test_scenes.h"
 
 namespace evfs {
 namespace test {

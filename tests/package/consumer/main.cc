@@ -5,13 +5,13 @@
 #include <cstdio>
 #include <string>
 
-#include "core/metrics.h"
-#include "core/version.h"
-#include "events/scene_synthesizer.h"
-#include "events/simulator.h"
-#include "scene/scene.h"
-#include "solver/reconstruction_options.h"
-#include "solver/reconstructor.h"
+#include "evfs/core/metrics.h"
+#include "evfs/core/version.h"
+#include "evfs/events/scene_synthesizer.h"
+#include "evfs/events/simulator.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstruction_options.h"
+#include "evfs/solver/reconstructor.h"
 
 namespace {
 

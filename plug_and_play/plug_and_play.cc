@@ -1,13 +1,13 @@
-#include "app/plug_and_play.h"
+#include "evfs/plug_and_play/plug_and_play.h"
 
 #include <Eigen/Core>
 #include <chrono>
 #include <cmath>
 #include <memory>
 
-#include "core/error.h"
-#include "core/option_checker.h"
-#include "solver/reconstructor.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
+#include "evfs/solver/reconstructor.h"
 
 namespace evfs {
 namespace {

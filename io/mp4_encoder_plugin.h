@@ -1,9 +1,9 @@
-// The C interface of the MP4 encoder plug-in (app/mp4_encoder_plugin.cc), a module that
+// The C interface of the MP4 encoder plug-in (io/mp4_encoder_plugin.cc), a module that
 // Mp4Writer opens with dlopen: OpenCV's videoio, with the FFmpeg and GStreamer libraries it
 // loads, then costs start-up time only to the commands that write MP4 files (BENCHMARKS.md,
 // "Start-up cost").
-#ifndef EVFS_APP_MP4_ENCODER_PLUGIN_H_
-#define EVFS_APP_MP4_ENCODER_PLUGIN_H_
+#ifndef EVFS_IO_MP4_ENCODER_PLUGIN_H_
+#define EVFS_IO_MP4_ENCODER_PLUGIN_H_
 
 extern "C" {
 
@@ -24,4 +24,4 @@ typedef void (*EvfsMp4CloseFunction)(void* encoder);
 #define EVFS_MP4_WRITE_SYMBOL "EvfsMp4Write"
 #define EVFS_MP4_CLOSE_SYMBOL "EvfsMp4Close"
 
-#endif  // EVFS_APP_MP4_ENCODER_PLUGIN_H_
+#endif  // EVFS_IO_MP4_ENCODER_PLUGIN_H_

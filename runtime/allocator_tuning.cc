@@ -1,4 +1,4 @@
-#include "app/allocator_tuning.h"
+#include "evfs/runtime/allocator_tuning.h"
 
 #include <malloc.h>
 #include <sys/mman.h>

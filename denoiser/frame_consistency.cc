@@ -1,9 +1,9 @@
-#include "app/frame_consistency.h"
+#include "evfs/denoiser/frame_consistency.h"
 
 #include <algorithm>
 #include <string>
 
-#include "core/error.h"
+#include "evfs/core/error.h"
 
 namespace evfs {
 namespace {

@@ -3,7 +3,7 @@
 // user error.
 //
 // The parent forwards SIGINT, SIGTERM and SIGHUP to the worker, waits for it, then removes the
-// paths the worker had registered and not finished (io/signal_cleanup.h: the staging folder of
+// paths the worker had registered and not finished (runtime/signal_cleanup.h: the staging folder of
 // an OutputTarget). Only then does it report: a signal ends the parent the same way, after one
 // line; a crash is one line and a non-zero status.
 //
@@ -12,8 +12,8 @@
 // A crash on a thread inside such a library reading the user's file (core/input_library.h,
 // ScopedInputLibraryRead) is reported as that file's fault. Every other crash, and every failed
 // CHECK, is a bug of evfs': an internal error.
-#ifndef EVFS_APP_CRASH_GUARD_H_
-#define EVFS_APP_CRASH_GUARD_H_
+#ifndef EVFS_RUNTIME_CRASH_GUARD_H_
+#define EVFS_RUNTIME_CRASH_GUARD_H_
 
 #include <sys/resource.h>
 
@@ -64,4 +64,4 @@ void InstallInternalErrorReporting(const std::string& prefix);
 
 }  // namespace evfs
 
-#endif  // EVFS_APP_CRASH_GUARD_H_
+#endif  // EVFS_RUNTIME_CRASH_GUARD_H_

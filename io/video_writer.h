@@ -1,13 +1,13 @@
 // Encoding frame sequences as MP4 files through OpenCV's VideoWriter (the FFmpeg back end of
 // Debian's OpenCV), for `evfs video`. The encoder lives in a plug-in opened on first use
-// (app/mp4_encoder_plugin.h), so that the other commands do not load videoio.
-#ifndef EVFS_APP_VIDEO_WRITER_H_
-#define EVFS_APP_VIDEO_WRITER_H_
+// (io/mp4_encoder_plugin.h), so that the other commands do not load videoio.
+#ifndef EVFS_IO_VIDEO_WRITER_H_
+#define EVFS_IO_VIDEO_WRITER_H_
 
 #include <string>
 #include <vector>
 
-#include "core/video.h"
+#include "evfs/core/video.h"
 
 namespace evfs {
 
@@ -46,4 +46,4 @@ class Mp4Writer {
 
 }  // namespace evfs
 
-#endif  // EVFS_APP_VIDEO_WRITER_H_
+#endif  // EVFS_IO_VIDEO_WRITER_H_

@@ -1,4 +1,4 @@
-#include "io/signal_cleanup.h"
+#include "evfs/runtime/signal_cleanup.h"
 
 #include <fcntl.h>
 #include <unistd.h>

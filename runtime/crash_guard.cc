@@ -1,4 +1,4 @@
-#include "app/crash_guard.h"
+#include "evfs/runtime/crash_guard.h"
 
 #include <glog/logging.h>
 #include <sys/mman.h>
@@ -17,9 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/error.h"
-#include "core/input_library.h"
-#include "io/signal_cleanup.h"
+#include "evfs/core/error.h"
+#include "evfs/core/input_library.h"
+#include "evfs/runtime/signal_cleanup.h"
 
 namespace evfs {
 

@@ -10,16 +10,16 @@
 // settle as the coupling tightens). Each x-update starts from the previous X (warm start). Only
 // the voxels the solver solved for take part: the others keep their values, which D leaves
 // unchanged (DenoiseRegion), so U stays 0 there.
-#ifndef EVFS_APP_PLUG_AND_PLAY_H_
-#define EVFS_APP_PLUG_AND_PLAY_H_
+#ifndef EVFS_PLUG_AND_PLAY_PLUG_AND_PLAY_H_
+#define EVFS_PLUG_AND_PLAY_PLUG_AND_PLAY_H_
 
 #include <string>
 #include <vector>
 
-#include "core/video.h"
-#include "denoiser/denoiser.h"
-#include "scene/scene.h"
-#include "solver/reconstruction_options.h"
+#include "evfs/core/video.h"
+#include "evfs/denoiser/denoiser.h"
+#include "evfs/scene/scene.h"
+#include "evfs/solver/reconstruction_options.h"
 
 namespace evfs {
 
@@ -57,4 +57,4 @@ Video PlugAndPlay(const Scene& scene, const ReconstructionOptions& options,
 
 }  // namespace evfs
 
-#endif  // EVFS_APP_PLUG_AND_PLAY_H_
+#endif  // EVFS_PLUG_AND_PLAY_PLUG_AND_PLAY_H_

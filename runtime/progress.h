@@ -9,8 +9,8 @@
 //
 // so that a job run from a script shows it is alive and where. A command that ends within its
 // first interval prints nothing: quick commands and their error lines stay as they are.
-#ifndef EVFS_APP_PROGRESS_H_
-#define EVFS_APP_PROGRESS_H_
+#ifndef EVFS_RUNTIME_PROGRESS_H_
+#define EVFS_RUNTIME_PROGRESS_H_
 
 #include <chrono>
 #include <condition_variable>
@@ -19,7 +19,7 @@
 #include <string>
 #include <thread>
 
-#include "solver/iteration_callback.h"
+#include "evfs/solver/iteration_callback.h"
 
 namespace evfs {
 
@@ -75,4 +75,4 @@ class ProgressReporter {
 
 }  // namespace evfs
 
-#endif  // EVFS_APP_PROGRESS_H_
+#endif  // EVFS_RUNTIME_PROGRESS_H_

@@ -1,5 +1,5 @@
-// The MP4 encoder plug-in (app/mp4_encoder_plugin.h): cv::VideoWriter behind a C interface.
-#include "app/mp4_encoder_plugin.h"
+// The MP4 encoder plug-in (io/mp4_encoder_plugin.h): cv::VideoWriter behind a C interface.
+#include "evfs/io/mp4_encoder_plugin.h"
 
 #include <malloc.h>
 #include <pthread.h>

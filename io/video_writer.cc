@@ -1,4 +1,4 @@
-#include "app/video_writer.h"
+#include "evfs/io/video_writer.h"
 
 #include <stdlib.h>
 
@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "app/mp4_encoder_plugin.h"
-#include "core/error.h"
-#include "core/plugin.h"
+#include "evfs/core/error.h"
+#include "evfs/core/plugin.h"
+#include "evfs/io/mp4_encoder_plugin.h"
 
 namespace evfs {
 namespace {
@@ -55,7 +55,7 @@ Mp4Writer::Mp4Writer(const std::string& path, double fps, int width, int height)
   // The same frames give the same bytes in every run (--jobs, --resume, MPI rank 0): the plug-in
   // opens x264 on one CPU, since x264 picks its thread count, which changes the stream, from
   // the CPUs it may use, and has glibc zero the memory it allocates, since x264 reads bytes it
-  // never wrote (app/mp4_encoder_plugin.cc). OPENCV_FFMPEG_WRITER_OPTIONS, set to "threads;1"
+  // never wrote (io/mp4_encoder_plugin.cc). OPENCV_FFMPEG_WRITER_OPTIONS, set to "threads;1"
   // here before, reaches no codec option in OpenCV 4.6, so it is left to the user.
   for (const char* codec : kMp4Codecs) {
     encoder_ = plugin.open(path.c_str(), codec, fps, width, height);

@@ -1,7 +1,7 @@
 // Process-wide malloc settings for the evfs executables (not the libraries: how a process
 // allocates is its owner's choice).
-#ifndef EVFS_APP_ALLOCATOR_TUNING_H_
-#define EVFS_APP_ALLOCATOR_TUNING_H_
+#ifndef EVFS_RUNTIME_ALLOCATOR_TUNING_H_
+#define EVFS_RUNTIME_ALLOCATOR_TUNING_H_
 
 namespace evfs {
 
@@ -27,4 +27,4 @@ void KeepFreedMemoryForReuse();
 
 }  // namespace evfs
 
-#endif  // EVFS_APP_ALLOCATOR_TUNING_H_
+#endif  // EVFS_RUNTIME_ALLOCATOR_TUNING_H_

@@ -13,14 +13,14 @@
 // observed frame (its brightness, a sharp frame itself) it gives back. The reconstruction then
 // explains the frames exactly as well as the solve left them. Measured on the validation cases
 // in BENCHMARKS.md ("Residual denoiser").
-#ifndef EVFS_APP_FRAME_CONSISTENCY_H_
-#define EVFS_APP_FRAME_CONSISTENCY_H_
+#ifndef EVFS_DENOISER_FRAME_CONSISTENCY_H_
+#define EVFS_DENOISER_FRAME_CONSISTENCY_H_
 
 #include <cstdint>
 #include <vector>
 
-#include "core/video.h"
-#include "scene/scene.h"
+#include "evfs/core/video.h"
+#include "evfs/scene/scene.h"
 
 namespace evfs {
 
@@ -51,4 +51,4 @@ std::vector<uint8_t> FramesToDenoise(const Scene& scene, std::vector<uint8_t> re
 
 }  // namespace evfs
 
-#endif  // EVFS_APP_FRAME_CONSISTENCY_H_
+#endif  // EVFS_DENOISER_FRAME_CONSISTENCY_H_

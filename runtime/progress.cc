@@ -1,4 +1,4 @@
-#include "app/progress.h"
+#include "evfs/runtime/progress.h"
 
 #include <cstdarg>
 #include <system_error>

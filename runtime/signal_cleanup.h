@@ -3,12 +3,12 @@
 //
 // Nothing can clean up reliably inside the process that a signal is ending: a signal handler
 // may not remove a folder tree, and while one thread removes it another may still be writing
-// into it. So the CLI runs each command in a worker child (app/crash_guard.h) and cleans up
+// into it. So the CLI runs each command in a worker child (runtime/crash_guard.h) and cleans up
 // from the parent, once the worker is gone and nothing writes any more: the worker reports
 // through a pipe each path it starts writing and each it has finished with (ScopedCleanupPath,
 // used by OutputTarget); the parent removes the paths still open when the worker ended.
-#ifndef EVFS_IO_SIGNAL_CLEANUP_H_
-#define EVFS_IO_SIGNAL_CLEANUP_H_
+#ifndef EVFS_RUNTIME_SIGNAL_CLEANUP_H_
+#define EVFS_RUNTIME_SIGNAL_CLEANUP_H_
 
 #include <string>
 #include <vector>
@@ -65,4 +65,4 @@ class ScopedCleanupPath {
 
 }  // namespace evfs
 
-#endif  // EVFS_IO_SIGNAL_CLEANUP_H_
+#endif  // EVFS_RUNTIME_SIGNAL_CLEANUP_H_
