@@ -725,7 +725,19 @@ ReconstructRequest ReconstructRequestFromOptions(const OptionValues& values, boo
   values.Apply("reconstruct.", &settings, skip);
   values.Apply("denoise", &settings);
   FinishReconstructRequest(values, &settings);
+  if (with_mode) settings.reconstruct.options = OptionsReadBy(values, "reconstruct");
   return settings.reconstruct;
+}
+
+std::vector<std::pair<std::string, std::string>> OptionsReadBy(const OptionValues& values,
+                                                               const std::string& command) {
+  std::vector<std::pair<std::string, std::string>> options;
+  for (const OptionDefinition& option : EvfsOptions()) {
+    if (option.ReadBy(command) && !(option.uses & kNotInFingerprint))
+      options.emplace_back(option.name, OptionValueText(values.Get(option.name)));
+  }
+  std::sort(options.begin(), options.end());
+  return options;
 }
 
 VideoRequest VideoRequestFromOptions(const OptionValues& values) {

@@ -7,7 +7,8 @@
 //   * the keys and defaults of Python's options (python/reconstruct_options.h),
 //   * the requests of reconstruct, video and simulate (the builders below, which the command
 //     line and Python share), and
-//   * the settings `evfs video --resume` compares, echoed in its summary.json (VideoFingerprint).
+//   * the settings `evfs video --resume` compares, echoed in its summary.json (VideoFingerprint),
+//     and the options `evfs reconstruct` echoes in its summary.json (OptionsReadBy).
 //
 // A new option is one row in evfs_options.cc; tests/app/evfs_options_test.cc fails for a flag
 // defined elsewhere in evfs or a request field the table does not set.
@@ -19,6 +20,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -137,6 +139,11 @@ ReconstructRequest ReconstructRequestFromOptions(const OptionValues& values, boo
 /// The request of video's options (evfs video and evfs.video), settings included; no callback
 /// is set.
 VideoRequest VideoRequestFromOptions(const OptionValues& values);
+
+/// Every option `command` reads (OptionDefinition::ReadBy) but those that say only where, how
+/// fast or how verbosely it runs (kNotInFingerprint), by name, with its value as text.
+std::vector<std::pair<std::string, std::string>> OptionsReadBy(const OptionValues& values,
+                                                               const std::string& command);
 
 /// "name=value " for every option not kNotInFingerprint, by name, then the bytes of a
 /// calibration file given as --event_model: what `evfs video --resume` compares.

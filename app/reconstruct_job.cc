@@ -547,6 +547,11 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
       checkpoints.push_back(std::move(entry));
     }
   }
+  if (!request.options.empty()) {
+    // The options the run was made from, as the option table names and prints them.
+    Json& options = json["options"];
+    for (const auto& [name, value] : request.options) options[name] = value;
+  }
   return json.dump(2);
 }
 

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "evfs/app/denoise_job.h"
 #include "evfs/app/method.h"
@@ -55,6 +57,9 @@ struct ReconstructRequest {
   bool checkpoints = false;
   /// The residual denoiser after the solve (DenoiseMode::kNone: none).
   DenoiseRequest denoise;
+  /// The options the request was made from, each name with its value as text, echoed in
+  /// summary.json (ReconstructRequestFromOptions fills it; empty for a request made in code).
+  std::vector<std::pair<std::string, std::string>> options;
   /// Sees every iteration of an iterative method (progress output); may be empty.
   IterationCallback progress;
   /// Told each stage as the job reaches it: "read", "bin", then "build" (with `progress`: the

@@ -856,7 +856,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
 
   // The work folder: the windows an interrupted run finished, and those left to solve.
   const std::string fingerprint =
-      VideoFingerprint(request.data_path, result.fps, request.settings, windows, clock);
+      WorkFolderFingerprint(request.data_path, result.fps, request.settings, windows, clock);
   const fs::path work = VideoWorkFolder(out_path);
   const bool worker = request.distribution != nullptr && !request.distribution->coordinator;
   // A worker process writes into the work folder its coordinator prepared.

@@ -132,8 +132,10 @@ int64_t CheckVideoOutput(const std::vector<VideoWindow>& windows, const OutputCl
   return output_frames;
 }
 
-std::string VideoFingerprint(const std::string& data_path, double fps, const std::string& settings,
-                             const std::vector<VideoWindow>& windows, const OutputClock& clock) {
+std::string WorkFolderFingerprint(const std::string& data_path, double fps,
+                                  const std::string& settings,
+                                  const std::vector<VideoWindow>& windows,
+                                  const OutputClock& clock) {
   std::ostringstream fingerprint;
   fingerprint << "data " << fs::absolute(data_path).lexically_normal().string() << "\n"
               << "fps " << fps << "\n"

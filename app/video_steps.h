@@ -3,7 +3,7 @@
 // this order:
 //
 //   FindUnreadableFrames → TestExposures → PlanVideo → VideoOutputFps → CheckVideoOutput →
-//   VideoFingerprint → (work folder, windows to reuse) → ScheduleVideo → (solve the windows) →
+//   WorkFolderFingerprint → (work folder, windows to reuse) → ScheduleVideo → (solve the windows) →
 //   (assemble frames and MP4) → SummarizeTruth → (summary.json)
 //
 // Each takes only what it reads and returns what the next one needs, so each is tested on its
@@ -56,8 +56,10 @@ int64_t CheckVideoOutput(const std::vector<VideoWindow>& windows, const OutputCl
 
 /// What must not change for --resume to reuse windows: the recording's absolute path, the
 /// rate, the settings and each window's plan.
-std::string VideoFingerprint(const std::string& data_path, double fps, const std::string& settings,
-                             const std::vector<VideoWindow>& windows, const OutputClock& clock);
+std::string WorkFolderFingerprint(const std::string& data_path, double fps,
+                                  const std::string& settings,
+                                  const std::vector<VideoWindow>& windows,
+                                  const OutputClock& clock);
 
 /// How the windows are solved in this process.
 struct VideoSchedule {

@@ -157,6 +157,33 @@ TEST(EvfsOptionsTest, FingerprintLeavesOutOnlyWhereHowFastAndHowVerbosely) {
   EXPECT_NE(VideoFingerprint(other), fingerprint);
 }
 
+TEST(EvfsOptionsTest, ReconstructEchoesEveryOptionItReadsFromTheTable) {
+  OptionValues values;
+  values.Set("mode", std::string("predict"));
+  values.Set("max_iterations", 7);
+  values.Set("jobs", 3);
+  const ReconstructRequest request = ReconstructRequestFromOptions(values, true);
+  std::set<std::string> echoed;
+  for (const auto& [name, value] : request.options) {
+    echoed.insert(name);
+    EXPECT_EQ(value, OptionValueText(values.Get(name))) << name;
+  }
+  for (const OptionDefinition& option : EvfsOptions()) {
+    const bool expected = option.ReadBy("reconstruct") && !(option.uses & kNotInFingerprint);
+    EXPECT_EQ(echoed.count(option.name), expected ? 1u : 0u) << option.name;
+  }
+  EXPECT_EQ(echoed.count("jobs"), 0u);  // video's only
+  EXPECT_EQ(echoed.count("out"), 0u);   // where, not what
+  EXPECT_TRUE(std::is_sorted(request.options.begin(), request.options.end()));
+  const auto max_iterations =
+      std::find_if(request.options.begin(), request.options.end(),
+                   [](const auto& option) { return option.first == "max_iterations"; });
+  ASSERT_NE(max_iterations, request.options.end());
+  EXPECT_EQ(max_iterations->second, "7");
+  // Video's request is made from the same table and carries its settings instead.
+  EXPECT_TRUE(ReconstructRequestFromOptions(values, false).options.empty());
+}
+
 TEST(EvfsOptionsTest, BuildersSetTheBoundFields) {
   OptionValues values;
   values.Set("mode", std::string("interpolate"));
@@ -261,6 +288,7 @@ TEST(EvfsOptionsTest, EveryRequestFieldIsAnOptionOrSaysWhyNot) {
       "reconstruct.data_label",
       "reconstruct.progress",
       "reconstruct.stage",
+      "reconstruct.options",  // the table's own echo of the options (OptionsReadBy)
       "video.data_label",
       "video.settings",
       "video.notice",

@@ -120,20 +120,20 @@ TEST(VideoStepsTest, OutputFramesAreCountedAndRunawayRatesRefused) {
 TEST(VideoStepsTest, TheFingerprintChangesWithWhatDecidesTheOutputOnly) {
   const std::vector<VideoWindow> windows = {Window(VideoWindowKind::kInterpolate, 0, 50)};
   const OutputClock clock(0, 200.0);
-  const std::string base = VideoFingerprint("rec", 200.0, "a=1", windows, clock);
-  EXPECT_EQ(base, VideoFingerprint("./rec", 200.0, "a=1", windows, clock));
-  EXPECT_EQ(base,
-            VideoFingerprint((fs::current_path() / "rec").string(), 200.0, "a=1", windows, clock));
-  EXPECT_NE(base, VideoFingerprint("other", 200.0, "a=1", windows, clock));
-  EXPECT_NE(base, VideoFingerprint("rec", 250.0, "a=1", windows, OutputClock(0, 250.0)));
-  EXPECT_NE(base, VideoFingerprint("rec", 200.0, "a=2", windows, clock));
+  const std::string base = WorkFolderFingerprint("rec", 200.0, "a=1", windows, clock);
+  EXPECT_EQ(base, WorkFolderFingerprint("./rec", 200.0, "a=1", windows, clock));
+  EXPECT_EQ(base, WorkFolderFingerprint((fs::current_path() / "rec").string(), 200.0, "a=1",
+                                        windows, clock));
+  EXPECT_NE(base, WorkFolderFingerprint("other", 200.0, "a=1", windows, clock));
+  EXPECT_NE(base, WorkFolderFingerprint("rec", 250.0, "a=1", windows, OutputClock(0, 250.0)));
+  EXPECT_NE(base, WorkFolderFingerprint("rec", 200.0, "a=2", windows, clock));
   std::vector<VideoWindow> blurred = windows;
   blurred[0].frames.resize(1);
   blurred[0].frames[0].blurred = true;
   std::vector<VideoWindow> sharp = blurred;
   sharp[0].frames[0].blurred = false;
-  EXPECT_NE(VideoFingerprint("rec", 200.0, "a=1", blurred, clock),
-            VideoFingerprint("rec", 200.0, "a=1", sharp, clock));
+  EXPECT_NE(WorkFolderFingerprint("rec", 200.0, "a=1", blurred, clock),
+            WorkFolderFingerprint("rec", 200.0, "a=1", sharp, clock));
 }
 
 TEST(VideoStepsTest, JobsAreCappedByCoresAndWindowsAndThreadsShareTheCores) {
