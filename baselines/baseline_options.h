@@ -41,19 +41,19 @@ struct BaselineOptions {
 
   // --- integrate ---
 
-  /// Linear by measurement: on the DAVIS snippets (slider 70→71 prediction, shapes 18→20
-  /// interpolation and 18→19 prediction) it scored 23.87, 33.01 and 32.80 dB against 23.91,
-  /// 32.65 and 32.31 dB for the best log offset (0.3); it is also the solver's default model.
+  /// Linear: on the DAVIS snippets it matches or beats the best log offset (one prediction
+  /// within noise, the other two windows above; benchmarks/results/model_choices.md, "The
+  /// baselines' settings"); it is also the solver's default model.
   IntegrationDomain domain = IntegrationDomain::kLinear;
-  /// b of log(I + b) for integrate (log domain) and cf, > 0. 0.3 by measurement on the same
-  /// snippets: with the assumed threshold cf scored 23.87 and 32.17 dB on the two predictions
-  /// against 22.50 and 29.09 dB for b = 0.1 and 20.72 and 23.36 dB for b = 1.
+  /// b of log(I + b) for integrate (log domain) and cf, > 0. 0.3: with the assumed threshold cf
+  /// predicts best there on the same snippets, both smaller and larger offsets lose (same
+  /// section).
   double log_offset = 0.3;
   IntegrationDirection direction = IntegrationDirection::kBoth;
   /// σ in pixels of a Gaussian blur (cv::GaussianBlur) of each integrated frame; 0 = none.
   /// Not part of the integration but a denoiser after it, which beats plain integration on the
-  /// DAVIS snippets (σ = 1: slider 24.93 against 23.87 dB, shapes interpolation 34.75 against
-  /// 33.01 dB); blurring only the event term, leaving the frame sharp, did worse on slider.
+  /// DAVIS snippets at σ = 1; blurring only the event term, leaving the frame sharp, does worse
+  /// on slider (same section).
   double blur_sigma_px = 0.0;
 
   // --- cf (Complementary Filter) ---
@@ -65,12 +65,9 @@ struct BaselineOptions {
   // --- edi (Event-based Double Integral) ---
 
   /// Weight of the total-variation term against the edge term of the sharpness energy, >= 0.
-  /// Chosen on simulated blur with ground truth: the 48×40 synthetic scene of the tests (21
-  /// frames at 1 kHz; blurred 32.69 dB) and nfs_basketball_7, adobe240_GOPR9642 and
-  /// adobe240_IMG_0036 from ../shared/data (means of 9 and 17 frames at 240 fps, simulated
-  /// events). 0.1: 36.97 dB on the synthetic scene, 26.68 dB mean on the clips (26.33 with 5 Hz
-  /// noise events); 0.05: 35.63, 26.89 (26.51); 0.02: 33.21, 26.96 (26.62); the threshold tuned
-  /// on the truth: 37.21, 27.41 (27.07). Small weights over-sharpen scenes with few moving edges.
+  /// Chosen on simulated blur with ground truth (the synthetic scene of the tests and three
+  /// clips of ../shared/data, same section): smaller weights gain a little on the busy clips and
+  /// lose more on the synthetic scene, since they over-sharpen scenes with few moving edges.
   double edi_tv_weight = 0.1;
   /// Events within this fraction of the exposure on either side of the reference time make the
   /// edge map the reconstruction is compared with, in (0, 1].

@@ -6,9 +6,9 @@
 // the log intensity has changed by the contrast threshold) summed over time, as in the paper's
 // Eq. 1. Forward from the sharp frame before t, backward from the one after, and between two
 // sharp frames both, weighted linearly in time: w = (τ_t − τ_j) / (τ_m − τ_j) for the later
-// frame m. Time weighting was measured against a plain mean on shapes_rotation 18→20 (frame 19
-// withheld): 31.63, 32.65, 33.01 dB (log b = 0.1, log b = 0.3, linear) against 31.31, 32.51,
-// 33.07 dB; it also makes the estimate continuous at the sharp frames.
+// frame m. Time weighting matches or beats a plain mean of the two directions
+// (benchmarks/results/model_choices.md, "The baselines' settings"), and it makes the estimate
+// continuous at the sharp frames.
 //
 // Event timing comes from the scene's event frames: N_t is the signed count of the frames that
 // end at or before latent frame t. A collision-binned frame spans one latent step (at most one

@@ -25,8 +25,9 @@ struct EventModelEstimationOptions {
   /// event reaches. Chosen by measurement on the shared DAVIS snippets (docs/model.md).
   double alpha_times_change = 1.0;
   /// Log model: change of g per event assumed when the scene cannot tell (one frame only).
-  /// 0.2 is a typical DAVIS contrast threshold; with the default b = 0.5 it is also what
-  /// slider_depth prediction measures best (α = 1/Δg 4 to 6: 25.12 dB; 8: 24.95 dB).
+  /// 0.2 is a typical DAVIS contrast threshold; with the default b = 0.5 it is also near what
+  /// slider_depth prediction measures best (benchmarks/results/model_choices.md, "The
+  /// baselines' settings").
   double assumed_contrast_threshold = 0.2;
   /// Linear model: intensity change per event assumed when the scene cannot tell.
   double assumed_linear_change = 0.09;

@@ -36,9 +36,8 @@ struct FrameLagOptions {
   int min_pixels = 100;
   /// The estimate is kept only when it removes at least this fraction of the misfit at zero
   /// shift, (r − r0) ≥ f · (1 − r0) with r0 the correlation at zero; otherwise the lag is 0: a
-  /// flat correlation curve says little about timing. 0.025: the shapes_rotation 18, 20 pair
-  /// peaks at +1.8 ms removing 1.9 % (and shifting by it costs 0.09 dB), while every simulated
-  /// window measured removes 3.2 % or more and gains 0.4 to 0.9 dB
+  /// flat correlation curve says little about timing. 0.025 lies between the real pair whose
+  /// shift costs PSNR and the simulated windows whose shift gains it
   /// (benchmarks/results/options_left_off.md, "Frame timing of sharp frames").
   double min_misfit_reduction = 0.025;
 

@@ -55,10 +55,9 @@ struct ObjectiveOptions {
   /// texture both frames show costs nothing to keep; an edge only one frame shows there is still
   /// penalised. Scenes without two sharp frames, or whose two frames' differences do not
   /// correlate positively (ObjectiveTerms::shared_structure_correlation), keep plain TV. On by
-  /// default: with the step ramps it lifts every quiet window above the blend and
-  /// event integration (GOPR9642 24, 28 → 26 by 1.1 dB) and no window the issue lists gets
-  /// worse (benchmarks/results/model_choices.md, "Spatial TV of what the frames do not
-  /// share").
+  /// default: with the step ramps it lifts every quiet window above the blend and event
+  /// integration, and no measured window gets worse (benchmarks/results/model_choices.md,
+  /// "Spatial TV of what the frames do not share").
   bool shared_structure_tv = true;
   /// ε of the pseudo-Huber smoothing of |r|: sqrt(ε² + r²) − ε.
   double smoothing_scale = 0.05;
@@ -134,8 +133,9 @@ struct ReconstructionOptions {
   /// time-weighted blend of the two between them: no event says its change stayed below the
   /// threshold, and the blend meets both frames, where the solve holds such a pixel constant at
   /// a value the ℓ1 frame terms leave undecided. 0: off (the default: at 0.5 it passes more
-  /// quiet windows but costs two clips' interpolations 0.06 dB; sweep:
-  /// benchmarks/results/model_choices.md, "Quiet scenes"). Not applied with a prior
+  /// quiet windows but costs two clips' interpolations; sweep:
+  /// benchmarks/results/options_left_off.md, "Quiet pixels: how much change"). Not applied
+  /// with a prior
   /// (objective.prior_weight).
   double quiet_blend_fraction = 0.0;
   static constexpr double kMaxQuietBlendFraction = 100.0;
@@ -154,8 +154,10 @@ struct ReconstructionOptions {
   /// ApplySharpFrameSeams; Reconstruct() itself leaves the solve's answer): each sharp frame's
   /// latent frame takes the frame's values and the offset fades out linearly in time to
   /// half-way to the neighbouring observation (or the window's end). The solve leaves a frame's
-  /// latent frame where the event and TV terms balance, 35 dB from an exact frame on a slow
-  /// window, and the frames next to it inherit the offset (solver/sharp_frame_seams.h).
+  /// latent frame where the event and TV terms balance, measurably off an exact frame even on a
+  /// slow window, and the frames next to it inherit the offset (solver/sharp_frame_seams.h;
+  /// benchmarks/results/model_choices.md, "Shared-structure TV and sharp frames met as
+  /// defaults").
   bool meet_sharp_frames = true;
   static constexpr double kMaxStepRampPx = 1.0e6;
   static constexpr int64_t kMaxProblemMb = int64_t{1} << 20;

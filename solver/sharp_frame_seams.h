@@ -3,13 +3,12 @@
 // (ReconstructionOptions::meet_sharp_frames).
 //
 // The solve treats a sharp frame as one observation among many event and TV terms, so the
-// latent frame at its time ends where those terms balance, not at the frame: on the simulated
-// GOPR9642 window 24, 28 → 26 both are 35.3–35.4 dB from the frames they observe, although the
-// frames are exact. The latent frames next to a sharp frame inherit that offset. A video made of
-// consecutive windows, which shows each observed frame as it is, then jumps at every observed
-// frame, and the frames just after or before one are worse than event integration from it
-// (GOPR9642, one quarter of a gap from a frame: up to 2 dB, benchmarks/results/model_choices.md,
-// "Quiet scenes").
+// latent frame at its time ends where those terms balance, not at the frame, even where the
+// frames are exact (simulated). The latent frames next to a sharp frame inherit that offset. A
+// video made of consecutive windows, which shows each observed frame as it is, then jumps at
+// every observed frame, and the frames just after or before one are worse than event
+// integration from it (benchmarks/results/model_choices.md, "Shared-structure TV and sharp
+// frames met as defaults").
 //
 // MeetSharpFrames() adds each sharp frame's offset δ = F − H(τ) to the latent frames around it,
 // with a weight of 1 at the frame that falls linearly in time to 0 half-way to the neighbouring

@@ -314,8 +314,8 @@ constexpr double kToneAugmentationProbability = 0.5;
 /// Maps every intensity I of `video` to low + (high - low) * I^gamma, with the range and gamma
 /// drawn so that dark, low-contrast scenes (a DAVIS sensor's frames: shapes_rotation's background
 /// sits near 0.35 and its shapes near 0.02) are as common as the full-range photographs. Without
-/// it the network learnt to soften every strong edge and lift black levels (−2 dB on a dark real
-/// recording). Returns the draw for the manifest.
+/// it the network learnt to soften every strong edge and lift black levels, which lowered PSNR on
+/// a dark real recording. Returns the draw for the manifest.
 std::string ToneAugment(Random* random, Video* video) {
   const double low = random->Uniform(0.0, 0.1);
   const double high = random->Uniform(low + 0.2, 1.0);

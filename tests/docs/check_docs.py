@@ -3,7 +3,8 @@
 
 --links: every relative link and image in every *.md file names a file that exists and, with
   '#anchor', a heading of that file (anchors as GitHub derives them from headings).
---comments: no code comment carries an issue number, a session stop number or a commit hash;
+--comments: no code comment carries an issue number, a session stop number or a commit hash,
+  and none outside tests/ and benchmarks/ a figure in dB;
   comments state the rule and why it holds, and the figures live in the benchmarks they name.
 """
 import argparse
@@ -85,6 +86,11 @@ COMMENT_MARKS = {".cc": "//", ".h": "//", ".cu": "//", ".py": "#", ".sh": "#", "
 FORBIDDEN = re.compile(r"\b(?:[Ii]ssues? #?\d+|[Ss]tops? \d+)\b|(?<![\w.-])(?=[0-9a-f]*[a-f])"
                        r"(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}(?![\w.+-])")
 
+# A measured figure in dB inside a library or tool comment; a test states its bound and a
+# benchmark its criterion in dB, and a quoted title (a sensor's dynamic range) is not a figure.
+DECIBELS = re.compile(r"[0-9]+(?:\.[0-9]+)? ?dB\b")
+QUOTED = re.compile(r'"[^"]*("|$)')
+
 
 def check_comments(root):
     problems = []
@@ -104,6 +110,11 @@ def check_comments(root):
             if match:
                 problems.append(f"{path.relative_to(root)}:{number}: '{match.group(0)}' in a "
                                 f"comment: {comment.strip()[:100]}")
+            figure = DECIBELS.search(QUOTED.sub("", comment))
+            if figure and path.relative_to(root).parts[0] not in ("tests", "benchmarks"):
+                problems.append(f"{path.relative_to(root)}:{number}: '{figure.group(0)}' in a "
+                                f"comment (the figure belongs in the benchmark the comment "
+                                f"names): {comment.strip()[:100]}")
     return problems
 
 

@@ -228,7 +228,8 @@ class PatchSampler:
         return torch.from_numpy(out)
 
 
-# The error floor of the db loss, as a mean squared error per active pixel (50 dB).
+# The error floor of the db loss, as a mean squared error per active pixel (a PSNR of
+# 10 · log10(1 / DB_LOSS_FLOOR)).
 DB_LOSS_FLOOR = 1e-5
 
 
