@@ -281,6 +281,7 @@ class RosbagDataSource::File {
   // lengths inside a chunk.
   void CheckChunks(const std::string& topic, const ros::Time& from, const ros::Time& to) const {
     const std::set<uint32_t>& connections = topic_connections_.at(topic);
+    bool checked_any = false;
     for (size_t i = 0; i < layout_.chunks.size(); ++i) {
       const rf::BagChunk& chunk = layout_.chunks[i];
       if (chunk_checked_[i]) continue;
@@ -300,7 +301,12 @@ class RosbagDataSource::File {
       // with, and a pass over every chunk then holds one chunk's pages, not the file's.
       file_.Release(chunk.data_begin, chunk.data_size);
       chunk_checked_[i] = true;
+      checked_any = true;
     }
+    // What each chunk's release leaves, the pages at its edges and those the kernel mapped in
+    // around each page read, goes once the pass is done: a pass over every chunk of a large bag
+    // would otherwise keep a few pages per chunk.
+    if (checked_any) file_.Release(0, file_.size());
   }
 
   std::string MessageName(const std::string& topic, const ros::Time& time) const {
