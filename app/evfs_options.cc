@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <type_traits>
 
@@ -17,6 +18,7 @@
 #include "evfs/core/enum_names.h"
 #include "evfs/core/error.h"
 #include "evfs/core/time.h"
+#include "evfs/core/value_range.h"
 #include "evfs/scene/event_model.h"
 #include "evfs/scene/frame_timing.h"
 #include "evfs/solver/reconstruction_options.h"
@@ -24,12 +26,32 @@
 namespace evfs {
 namespace {
 
-OptionValue Bool(bool value) { return value; }
-OptionValue Int32(int32_t value) { return value; }
-OptionValue Int64(int64_t value) { return value; }
-OptionValue Uint64(uint64_t value) { return value; }
-OptionValue Double(double value) { return value; }
-OptionValue Text(const std::string& value) { return value; }
+// A row's default and the values the option accepts: a number's range is declared with it.
+struct Accepted {
+  OptionValue default_value;
+  ValueRange range = ValueRange::Any();
+};
+
+Accepted Bool(bool value) { return {value}; }
+Accepted Text(const std::string& value) { return {value}; }
+Accepted Int32(int32_t value, ValueRange range) { return {value, range}; }
+Accepted Int64(int64_t value, ValueRange range) { return {value, range}; }
+Accepted Uint64(uint64_t value, ValueRange range) { return {value, range}; }
+Accepted Double(double value, ValueRange range) { return {value, range}; }
+
+// A number as a double, to compare with a range; nullopt for a text or a switch.
+std::optional<double> NumberOf(const OptionValue& value) {
+  return std::visit(
+      [](const auto& v) -> std::optional<double> {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::string>) {
+          return std::nullopt;
+        } else {
+          return static_cast<double>(v);
+        }
+      },
+      value);
+}
 
 // The bindings of the table's rows: the field's path as text (for the table's readers and
 // tests/app/evfs_options_test.cc) and a setter of that field, from one mention of the path.
@@ -115,26 +137,28 @@ void SetRefractoryPeriod(const OptionValue& value, const std::string&, EvfsSetti
   settings->simulator.refractory_period_ns = SecondsToNanoseconds(std::get<double>(value));
 }
 
-// A row of the table: OptionDefinition less ReadBy, its binding given as (field, setter).
+// A row of the table: OptionDefinition less ReadBy, its binding given as (field, setter). The
+// help of a bounded option ends with its range.
 OptionDefinition Row(const char* name, const char* group, const char* commands, unsigned uses,
-                     OptionValue default_value, const char* help, std::string field,
-                     OptionSetter set) {
+                     Accepted accepted, const char* help, std::string field, OptionSetter set) {
   OptionDefinition option;
   option.name = name;
   option.group = group;
   option.commands = commands;
   option.uses = uses;
-  option.default_value = std::move(default_value);
+  option.default_value = std::move(accepted.default_value);
+  option.range = accepted.range;
   option.help = help;
+  if (option.range.Bounded()) option.help += " Values: " + option.range.Text() + ".";
   option.field = std::move(field);
   option.set = std::move(set);
   return option;
 }
 
 OptionDefinition Row(const char* name, const char* group, const char* commands, unsigned uses,
-                     OptionValue default_value, const char* help,
+                     Accepted accepted, const char* help,
                      std::pair<std::string, OptionSetter> binding) {
-  return Row(name, group, commands, uses, std::move(default_value), help, std::move(binding.first),
+  return Row(name, group, commands, uses, std::move(accepted), help, std::move(binding.first),
              std::move(binding.second));
 }
 
@@ -156,17 +180,20 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "simulate: folder with images.txt ('t path' lines) and the frames.", Unbound()),
       Row("mode", "data", "reconstruct", 0, Text(""), "interpolate | predict | deblur.",
           EVFS_OPTION_PARSED(reconstruct.mode, ParseMode)),
-      Row("first", "data", "info reconstruct video calibrate", 0, Int32(-1),
+      Row("first", "data", "info reconstruct video calibrate", 0,
+          Int32(-1, ValueRange::AtLeast(0).Or(-1)),
           "0-based images.txt line of the first (or blurred) frame.",
           EVFS_OPTION_FIELD(reconstruct.first)),
-      Row("last", "data", "info reconstruct video calibrate", 0, Int32(-1),
+      Row("last", "data", "info reconstruct video calibrate", 0,
+          Int32(-1, ValueRange::AtLeast(0).Or(-1)),
           "interpolate: the last frame; predict: the frame whose time ends the window (default "
           "first + 1); info: with --first, the window to describe.",
           EVFS_OPTION_FIELD(reconstruct.last)),
-      Row("truth", "data", "reconstruct", 0, Int32(-1),
+      Row("truth", "data", "reconstruct", 0, Int32(-1, ValueRange::AtLeast(0).Or(-1)),
           "Frame to score the reconstruction against (PSNR, SSIM); -1: none.",
           EVFS_OPTION_FIELD(reconstruct.truth)),
-      Row("exposure_s", "data", "reconstruct video simulate", kReconstructKey, Double(0.0),
+      Row("exposure_s", "data", "reconstruct video simulate", kReconstructKey,
+          Double(0.0, ValueRange::Between(0.0, kMaxDurationS)),
           "deblur: exposure around the frame's timestamp, when the data has no exposures.txt. "
           "simulate: the written frames' exposure, each the mean of the scene over it (with "
           "exposures.txt); 0: the scene at the timestamp.",
@@ -189,7 +216,8 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "Replace --out when it holds an earlier output of the same command (marked by "
           "OUT/.evfs-output, or an .h5/.aedat4 file evfs wrote); nothing else is replaced.",
           Unbound()),
-      Row("fps", "output", "reconstruct video", kReconstructKey, Double(0.0),
+      Row("fps", "output", "reconstruct video", kReconstructKey,
+          Double(0.0, ValueRange::AtLeast(0.0)),
           "Resample the latent video to this uniform frame rate; 0 writes the latent frames "
           "themselves.",
           EVFS_OPTION_FIELD(reconstruct.fps)),
@@ -208,23 +236,23 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "into summary.json.",
           EVFS_OPTION_FIELD(reconstruct.checkpoints)),
       Row("adam_iterations", "method", "reconstruct video", kReconstructKey,
-          Int32(AdamOptions().max_iterations), "adam, adam_smooth: steps.",
+          Int32(AdamOptions().max_iterations, ValueRange::AtLeast(0)), "adam, adam_smooth: steps.",
           EVFS_OPTION_FIELD(reconstruct.method.adam.max_iterations)),
       Row("adam_learning_rate", "method", "reconstruct video", kReconstructKey,
-          Double(AdamOptions().learning_rate),
+          Double(AdamOptions().learning_rate, ValueRange::Above(0.0)),
           "adam, adam_smooth: initial learning rate (divided by 5 every 200 steps).",
           EVFS_OPTION_FIELD(reconstruct.method.adam.learning_rate)),
       Row("contrast_threshold", "method", "reconstruct video", kReconstructKey,
-          Double(BaselineOptions().contrast_threshold),
+          Double(BaselineOptions().contrast_threshold, ValueRange::Any()),
           "integrate, cf, edi (and --init=events): change one event stands for; 0 derives it from "
           "the data.",
           EVFS_OPTION_FIELD(reconstruct.method.baseline.contrast_threshold)),
       Row("blur_sigma_px", "method", "reconstruct video", kReconstructKey,
-          Double(BaselineOptions().blur_sigma_px),
+          Double(BaselineOptions().blur_sigma_px, ValueRange::AtLeast(0.0)),
           "integrate: Gaussian blur (pixels) after integration; 0: none.",
           EVFS_OPTION_FIELD(reconstruct.method.baseline.blur_sigma_px)),
       Row("cf_cutoff_rad_per_s", "method", "reconstruct video", kReconstructKey,
-          Double(BaselineOptions().cutoff_rad_per_s),
+          Double(BaselineOptions().cutoff_rad_per_s, ValueRange::AtLeast(0.0).WithInfinity()),
           "cf: crossover frequency of the complementary filter.",
           EVFS_OPTION_FIELD(reconstruct.method.baseline.cutoff_rad_per_s)),
       Row("binning", "binning", "info reconstruct video", kReconstructKey, Text("auto"),
@@ -233,27 +261,27 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "beyond --max_latent_voxels is refused.",
           EVFS_OPTION_NAMED(reconstruct.binning.method, kBinningMethodNames)),
       Row("max_latent_frames", "binning", "info reconstruct video", kReconstructKey,
-          Int32(BinningOptions().max_latent_frames),
+          Int32(BinningOptions().max_latent_frames, ValueRange::AtLeast(1)),
           "auto binning: most latent steps before switching to stacked equal-time binning with "
           "this many frames.",
           EVFS_OPTION_FIELD(reconstruct.binning.max_latent_frames)),
       Row("min_latent_steps", "binning", "info reconstruct video", kReconstructKey,
-          Int32(BinningOptions().min_latent_steps),
+          Int32(BinningOptions().min_latent_steps, ValueRange::AtLeast(0)),
           "auto binning: collision frames split in time until the window has this many latent "
           "steps (within --max_latent_frames and --max_latent_voxels); 0: as they are.",
           EVFS_OPTION_FIELD(reconstruct.binning.min_latent_steps)),
       Row("max_latent_voxels", "binning", "info reconstruct video", kReconstructKey,
-          Int64(BinningOptions().max_latent_voxels),
+          Int64(BinningOptions().max_latent_voxels, ValueRange::AtLeast(1)),
           "Most pixels x latent frames, decided from event counts before anything is allocated; "
           "bounds memory and time (auto binning takes as many steps as fit).",
           EVFS_OPTION_FIELD(reconstruct.binning.max_latent_voxels)),
       Row("hot_pixel_factor", "binning", "info reconstruct video", kReconstructKey,
-          Double(BinningOptions().hot_pixel_factor),
+          Double(BinningOptions().hot_pixel_factor, ValueRange::AtLeast(0.0)),
           "Leave out the events of hot pixels: those firing more than this many times as often as "
           "the window's busy pixels (the busiest outside the top 1 %); 0 keeps every event.",
           EVFS_OPTION_FIELD(reconstruct.binning.hot_pixel_factor)),
       Row("saturation_level", "binning", "info reconstruct video calibrate", kReconstructKey,
-          Double(BinningOptions().saturation_level),
+          Double(BinningOptions().saturation_level, ValueRange::Above(0.0)),
           "A frame pixel at or above this level (intensity in [0, 1]) is saturated "
           "(--flicker_min_reversals, --leave_out_saturated); above 1: none is.",
           EVFS_OPTION_FIELD(reconstruct.binning.saturation_level)),
@@ -263,34 +291,39 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "cannot show what they record).",
           EVFS_OPTION_FIELD(reconstruct.binning.leave_out_saturated)),
       Row("flicker_min_reversals", "binning", "info reconstruct video", kReconstructKey,
-          Int32(BinningOptions().flicker_min_reversals),
+          Int32(BinningOptions().flicker_min_reversals, ValueRange::AtLeast(0)),
           "Leave out the events of pixels whose events reverse polarity at least this many times "
           "in the window with almost no net change (a blinking LED, a mains-powered lamp), next to "
           "a pixel a frame shows saturated: the frames govern there; 0 keeps them.",
           EVFS_OPTION_FIELD(reconstruct.binning.flicker_min_reversals)),
       Row("noise_filter_ms", "binning", "info reconstruct video", kReconstructKey,
-          Double(BinningOptions().noise_filter_ms),
+          Double(BinningOptions().noise_filter_ms,
+                 ValueRange::Between(0.0, BinningOptions::kMaxNoiseFilterMs)),
           "Leave out events that no neighbouring pixel confirms within this many ms "
           "(background-activity filter); 0 keeps every event.",
           EVFS_OPTION_FIELD(reconstruct.binning.noise_filter_ms)),
       Row("stacked_frames", "binning", "info reconstruct video", kReconstructKey,
-          Int32(BinningOptions().stacked.num_frames), "stacked binning: number of event frames.",
+          Int32(BinningOptions().stacked.num_frames, ValueRange::AtLeast(1)),
+          "stacked binning: number of event frames.",
           EVFS_OPTION_FIELD(reconstruct.binning.stacked.num_frames)),
       Row("frame_weight", "model", "reconstruct video", kReconstructKey,
-          Double(ObjectiveOptions().frame_weight), "Weight of the frame term.",
+          Double(ObjectiveOptions().frame_weight, ValueRange::AtLeast(0.0)),
+          "Weight of the frame term.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.frame_weight)),
       Row("event_weight", "model", "reconstruct video", kReconstructKey,
-          Double(ObjectiveOptions().event_weight), "lambda_e: weight of the event term.",
+          Double(ObjectiveOptions().event_weight, ValueRange::AtLeast(0.0)),
+          "lambda_e: weight of the event term.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.event_weight)),
       Row("spatial_tv_weight", "model", "reconstruct video", kReconstructKey,
-          Double(ObjectiveOptions().spatial_tv_weight),
+          Double(ObjectiveOptions().spatial_tv_weight, ValueRange::AtLeast(0.0)),
           "lambda_xy: weight of spatial total variation.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.spatial_tv_weight)),
       Row("temporal_tv_weight", "model", "reconstruct video", kReconstructKey,
-          Double(ObjectiveOptions().temporal_tv_weight),
+          Double(ObjectiveOptions().temporal_tv_weight, ValueRange::AtLeast(0.0)),
           "lambda_t: weight of temporal total variation.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.temporal_tv_weight)),
-      Row("alpha", "model", "reconstruct video", kReconstructKey, Double(0.0),
+      Row("alpha", "model", "reconstruct video", kReconstructKey,
+          Double(0.0, ValueRange::AtMost(ObjectiveOptions::kMaxAlpha)),
           "alpha of tanh(alpha * dg); 0 derives it from the data's contrast threshold (printed).",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.event_model.alpha)),
       Row("event_model", "model", "reconstruct video", kReconstructKey,
@@ -300,8 +333,9 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "threshold and the OFF/ON ratio; --log_offset, --alpha and --event_saturation given as "
           "well win).",
           Custom("reconstruct.method.reconstruction.objective.event_model.model", SetEventModel)),
-      Row("event_saturation", "model", "reconstruct video", kReconstructKey, Double(0.0),
-          "c of the event model c tanh(alpha dg / c), >= 1 (1: the paper's); 0 derives it: above 1 "
+      Row("event_saturation", "model", "reconstruct video", kReconstructKey,
+          Double(0.0, ValueRange::AtLeast(1.0).Or(0.0)),
+          "c of the event model c tanh(alpha dg / c) (1: the paper's); 0 derives it: above 1 "
           "when the change per event is measured between two frames, else 1.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.event_model.saturation)),
       Row("per_polarity_alpha", "model", "reconstruct video", kReconstructKey,
@@ -311,7 +345,8 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "alpha.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.estimation.per_polarity)),
       Row("log_offset", "model", "reconstruct video", kReconstructKey,
-          Double(ObjectiveOptions().event_model.log_offset), "b of the log event model.",
+          Double(ObjectiveOptions().event_model.log_offset, ValueRange::Above(0.0)),
+          "b of the log event model.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.event_model.log_offset)),
       Row("spatial_tv", "model", "reconstruct video", kReconstructKey, Text("anisotropic"),
           "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | isotropic (sqrt(dx^2+dy^2)).",
@@ -323,7 +358,7 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "place (minmod of their differences): texture they share is kept, moved edges are not.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.shared_structure_tv)),
       Row("smoothing_scale", "model", "reconstruct video", kReconstructKey,
-          Double(ObjectiveOptions().smoothing_scale),
+          Double(ObjectiveOptions().smoothing_scale, ValueRange::Above(0.0)),
           "epsilon of the smoothed l1: sqrt(eps^2 + r^2) - eps.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.smoothing_scale)),
       Row("smoothing_continuation", "model", "reconstruct video", kReconstructKey | kNumberList,
@@ -336,7 +371,7 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "Keep intensities in [0, 1].",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.bound_intensities)),
       Row("activity_radius_px", "model", "reconstruct video", kReconstructKey,
-          Int32(ReconstructionOptions().activity_radius_px),
+          Int32(ReconstructionOptions().activity_radius_px, ValueRange::AtLeast(0).Or(-1)),
           "Solve only pixels within this distance of an event of the window; the others keep their "
           "initial value. -1 solves every pixel.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.activity_radius_px)),
@@ -356,19 +391,22 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "another with --progress or --checkpoints); false: one problem.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.split_independent_parts)),
       Row("max_problem_mb", "model", "reconstruct video", kReconstructKey,
-          Int64(ReconstructionOptions().max_problem_mb),
+          Int64(ReconstructionOptions().max_problem_mb,
+                ValueRange::AtMost(ReconstructionOptions::kMaxProblemMb)),
           "Most memory (MiB) the Ceres problems hold at once, estimated before building: larger "
           "problems are solved in batches of parts, or in overlapping bands of rows, one after "
           "another; <= 0: no limit.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.max_problem_mb)),
       Row("quiet_blend_fraction", "model", "reconstruct video", kReconstructKey,
-          Double(ReconstructionOptions().quiet_blend_fraction),
+          Double(ReconstructionOptions().quiet_blend_fraction,
+                 ValueRange::Between(0.0, ReconstructionOptions::kMaxQuietBlendFraction)),
           "After the solve, pixels no event fired whose sharp frames differ by less than this "
           "fraction of one event's change take the time-weighted blend of the frames between them; "
           "0: off.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.quiet_blend_fraction)),
       Row("step_ramp_px", "model", "reconstruct video", kReconstructKey,
-          Double(ReconstructionOptions().step_ramp_px),
+          Double(ReconstructionOptions().step_ramp_px,
+                 ValueRange::Between(0.0, ReconstructionOptions::kMaxStepRampPx)),
           "After the solve, each step of a solved pixel becomes a ramp that ends at the step and "
           "lasts the time the scene takes to move this many pixels there (measured from the "
           "events), begun no earlier than the middle of the segment before; 0: steps stay jumps.",
@@ -388,33 +426,37 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "exactly: fewer CG steps, dearer ones) | ...",
           Custom("reconstruct.method.reconstruction.solver.preconditioner_type",
                  SetPreconditioner)),
-      Row("eta", "solver", "reconstruct video", kReconstructKey, Double(DefaultSolverOptions().eta),
+      Row("eta", "solver", "reconstruct video", kReconstructKey,
+          Double(DefaultSolverOptions().eta, ValueRange::Above(0.0)),
           "Inexact Newton forcing sequence: CG stops at relative residual eta.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.solver.eta)),
       Row("max_iterations", "solver", "reconstruct video", kReconstructKey,
-          Int32(DefaultSolverOptions().max_num_iterations), "Most Levenberg-Marquardt iterations.",
+          Int32(DefaultSolverOptions().max_num_iterations, ValueRange::AtLeast(0)),
+          "Most Levenberg-Marquardt iterations.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.solver.max_num_iterations)),
       Row("max_linear_iterations", "solver", "reconstruct video", kReconstructKey,
-          Int32(DefaultSolverOptions().max_linear_solver_iterations),
+          Int32(DefaultSolverOptions().max_linear_solver_iterations, ValueRange::AtLeast(1)),
           "Most CG iterations per LM step.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.solver.max_linear_solver_iterations)),
-      Row("max_time_s", "solver", "reconstruct video", kReconstructKey, Double(1e6),
+      Row("max_time_s", "solver", "reconstruct video", kReconstructKey,
+          Double(1e6, ValueRange::AtLeast(0.0)),
           "Time budget in seconds of the whole solve of reconstruct (every stage, part, band and "
           "plug & play iteration together) or of each window of video: the solve ends with the "
           "answer it has (summary.json solver.stopped_early says so).",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.solver.max_solver_time_in_seconds)),
       Row("bounds_line_search_iterations", "solver", "reconstruct video", kReconstructKey,
-          Int32(DefaultSolverOptions().max_num_line_search_step_size_iterations),
+          Int32(DefaultSolverOptions().max_num_line_search_step_size_iterations,
+                ValueRange::AtLeast(0)),
           "Steps of Ceres' projected line search after each bounded trust-region step (0: none; "
           "the step is only projected onto the bounds).",
           EVFS_OPTION_FIELD(
               reconstruct.method.reconstruction.solver.max_num_line_search_step_size_iterations)),
       Row("function_tolerance", "solver", "reconstruct video", kReconstructKey,
-          Double(DefaultSolverOptions().function_tolerance),
+          Double(DefaultSolverOptions().function_tolerance, ValueRange::AtLeast(0.0)),
           "Stop when the relative cost change falls below this.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.solver.function_tolerance)),
       Row("threads", "solver", "reconstruct video", kReconstructKey | kNotInFingerprint,
-          Int32(DefaultSolverOptions().num_threads),
+          Int32(DefaultSolverOptions().num_threads, ValueRange::Between(1, kMaxThreads)),
           "Threads for Jacobian evaluation and the linear solver.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.solver.num_threads)),
       Row("in", "denoiser", "denoise", 0, Text(""),
@@ -443,10 +485,11 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "only where the solve is unsure.",
           EVFS_OPTION_FIELD(reconstruct.denoise.gate)),
       Row("denoise_gate_tau", "denoiser", "reconstruct video", kReconstructKey,
-          Double(DenoiseRequest().gate_tau),
-          "--denoise_gate: tau in intensity units, >= 0; 0: 24 x the frames' noise sigma.",
+          Double(DenoiseRequest().gate_tau, ValueRange::AtLeast(0.0)),
+          "--denoise_gate: tau in intensity units; 0: 24 x the frames' noise sigma.",
           EVFS_OPTION_FIELD(reconstruct.denoise.gate_tau)),
-      Row("jobs", "solver", "video", kNotInFingerprint, Int32(0),
+      Row("jobs", "solver", "video", kNotInFingerprint,
+          Int32(0, ValueRange::Between(0, kMaxThreads)),
           "video: windows solved at once; 0: every core.", EVFS_OPTION_FIELD(video.jobs)),
       Row("resume", "output", "video", kNotInFingerprint, Bool(false),
           "video: reuse the windows an interrupted run of the same command finished (kept in "
@@ -465,11 +508,12 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
       Row("predict_tail", "data", "video", 0, Bool(true),
           "video: predict after the recording's last frame up to the last event.",
           EVFS_OPTION_FIELD(video.windows.predict_tail)),
-      Row("predict_max_s", "data", "video", 0, Double(0.0),
+      Row("predict_max_s", "data", "video", 0, Double(0.0, ValueRange::Between(0.0, kMaxDurationS)),
           "video: longest prediction after the last frame, seconds; 0: the median gap between "
           "observed frames.",
           EVFS_OPTION_FIELD(video.windows.predict_max_s)),
-      Row("min_blur_exposure_s", "data", "video", 0, Double(0.0),
+      Row("min_blur_exposure_s", "data", "video", 0,
+          Double(0.0, ValueRange::Between(0.0, kMaxDurationS)),
           "video: a frame whose exposure is at least this long is deblurred (observed over its "
           "exposure); 0: every frame with a known exposure.",
           EVFS_OPTION_FIELD(video.windows.min_blur_exposure_s)),
@@ -478,7 +522,7 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "blurred it (the blur the events predict against the frame's own noise); false: every "
           "frame with a known exposure of at least --min_blur_exposure_s is blurred.",
           EVFS_OPTION_FIELD(video.windows.blur_from_data)),
-      Row("frame_step", "data", "video", 0, Int32(1),
+      Row("frame_step", "data", "video", 0, Int32(1, ValueRange::Between(1, 1000000)),
           "video: observe every N-th frame and score the frames between (ground truth); 1: every "
           "frame.",
           EVFS_OPTION_FIELD(video.windows.frame_step)),
@@ -491,94 +535,104 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "'..').",
           Unbound()),
       Row("threshold_pos", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().contrast_threshold_pos),
+          Double(SimulatorOptions().contrast_threshold_pos, ValueRange::Above(0.0)),
           "simulate: ON contrast threshold (log intensity).",
           EVFS_OPTION_FIELD(simulator.contrast_threshold_pos)),
       Row("threshold_neg", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().contrast_threshold_neg),
+          Double(SimulatorOptions().contrast_threshold_neg, ValueRange::Above(0.0)),
           "simulate: OFF contrast threshold (log intensity).",
           EVFS_OPTION_FIELD(simulator.contrast_threshold_neg)),
       Row("threshold_sigma", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().threshold_sigma),
+          Double(SimulatorOptions().threshold_sigma, ValueRange::AtLeast(0.0)),
           "simulate: per-pixel spread (std dev) of the thresholds.",
           EVFS_OPTION_FIELD(simulator.threshold_sigma)),
-      Row("log_eps", "simulator", "simulate", kSimulateKey, Double(SimulatorOptions().log_eps),
-          "simulate: offset b of the sensor's log intensity log(I + b), > 0.",
+      Row("log_eps", "simulator", "simulate", kSimulateKey,
+          Double(SimulatorOptions().log_eps, ValueRange::Above(0.0)),
+          "simulate: offset b of the sensor's log intensity log(I + b).",
           EVFS_OPTION_FIELD(simulator.log_eps)),
-      Row("refractory_s", "simulator", "simulate", kSimulateKey, Double(0.0),
-          "simulate: refractory period in seconds.",
+      Row("refractory_s", "simulator", "simulate", kSimulateKey,
+          Double(0.0, ValueRange::AtLeast(0.0)), "simulate: refractory period in seconds.",
           Custom("simulator.refractory_period_ns", SetRefractoryPeriod)),
       Row("noise_rate_hz", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().noise_rate_hz),
+          Double(SimulatorOptions().noise_rate_hz, ValueRange::AtLeast(0.0)),
           "simulate: background noise events per pixel per second.",
           EVFS_OPTION_FIELD(simulator.noise_rate_hz)),
-      Row("seed", "simulator", "simulate", kSimulateKey, Uint64(SimulatorOptions().seed),
-          "simulate: random seed.", EVFS_OPTION_FIELD(simulator.seed)),
+      Row("seed", "simulator", "simulate", kSimulateKey,
+          Uint64(SimulatorOptions().seed, ValueRange::AtLeast(0)), "simulate: random seed.",
+          EVFS_OPTION_FIELD(simulator.seed)),
       Row("leak_rate_hz", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().leak_rate_hz),
+          Double(SimulatorOptions().leak_rate_hz, ValueRange::AtLeast(0.0)),
           "simulate: leak (ON) events per pixel per second (v2e's default: 0.1); 0: none.",
           EVFS_OPTION_FIELD(simulator.leak_rate_hz)),
       Row("leak_jitter_fraction", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().leak_jitter_fraction),
+          Double(SimulatorOptions().leak_jitter_fraction, ValueRange::AtLeast(0.0)),
           "simulate: per-pixel spread of the leak rate, a fraction of it (v2e).",
           EVFS_OPTION_FIELD(simulator.leak_jitter_fraction)),
-      Row("cutoff_hz", "simulator", "simulate", kSimulateKey, Double(SimulatorOptions().cutoff_hz),
+      Row("cutoff_hz", "simulator", "simulate", kSimulateKey,
+          Double(SimulatorOptions().cutoff_hz, ValueRange::Between(0.0, 1e6)),
           "simulate: photoreceptor cutoff frequency at full intensity in Hz, falling with "
           "intensity (v2e); 0: none.",
           EVFS_OPTION_FIELD(simulator.cutoff_hz)),
       Row("hot_pixel_fraction", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().hot_pixel_fraction),
-          "simulate: fraction of pixels that are hot, in [0, 1].",
+          Double(SimulatorOptions().hot_pixel_fraction, ValueRange::Between(0.0, 1.0)),
+          "simulate: fraction of pixels that are hot.",
           EVFS_OPTION_FIELD(simulator.hot_pixel_fraction)),
       Row("hot_pixel_rate_hz", "simulator", "simulate", kSimulateKey,
-          Double(SimulatorOptions().hot_pixel_rate_hz),
+          Double(SimulatorOptions().hot_pixel_rate_hz, ValueRange::Above(0.0)),
           "simulate: events per second of each hot pixel (random polarity).",
           EVFS_OPTION_FIELD(simulator.hot_pixel_rate_hz)),
-      Row("flicker_led_hz", "simulator", "simulate", 0, Double(FlickerOptions().led_hz),
+      Row("flicker_led_hz", "simulator", "simulate", 0,
+          Double(FlickerOptions().led_hz, ValueRange::Between(1.0, 1e5).Or(0.0)),
           "simulate: a blinking LED (square wave) at this frequency in Hz; 0: none. Needs "
           "--flicker_led_xy_px.",
           EVFS_OPTION_FIELD(flicker.led_hz)),
       Row("flicker_led_xy_px", "simulator", "simulate", 0, Text(""),
           "simulate: the LED disc's centre 'X,Y' in pixels.", Unbound()),
       Row("flicker_led_radius_px", "simulator", "simulate", 0,
-          Double(FlickerOptions().led_radius_px), "simulate: the LED disc's radius in pixels.",
-          EVFS_OPTION_FIELD(flicker.led_radius_px)),
+          Double(FlickerOptions().led_radius_px, ValueRange::Above(0.0)),
+          "simulate: the LED disc's radius in pixels.", EVFS_OPTION_FIELD(flicker.led_radius_px)),
       Row("flicker_led_intensity", "simulator", "simulate", 0,
-          Double(FlickerOptions().led_intensity),
+          Double(FlickerOptions().led_intensity, ValueRange::Above(0.0)),
           "simulate: intensity the lit LED adds (1: white; above 1 saturates the frames).",
           EVFS_OPTION_FIELD(flicker.led_intensity)),
-      Row("flicker_led_duty", "simulator", "simulate", 0, Double(FlickerOptions().led_duty),
-          "simulate: fraction of each LED period it is lit, in (0, 1).",
-          EVFS_OPTION_FIELD(flicker.led_duty)),
-      Row("mains_hz", "simulator", "simulate", 0, Double(FlickerOptions().mains_hz),
+      Row("flicker_led_duty", "simulator", "simulate", 0,
+          Double(FlickerOptions().led_duty, ValueRange::Inside(0.0, 1.0)),
+          "simulate: fraction of each LED period it is lit.", EVFS_OPTION_FIELD(flicker.led_duty)),
+      Row("mains_hz", "simulator", "simulate", 0,
+          Double(FlickerOptions().mains_hz, ValueRange::Between(1.0, 1e5).Or(0.0)),
           "simulate: a mains lamp's flicker frequency in Hz (100 on 50 Hz mains, 120 on 60 Hz); 0: "
           "none.",
           EVFS_OPTION_FIELD(flicker.mains_hz)),
-      Row("mains_depth", "simulator", "simulate", 0, Double(FlickerOptions().mains_depth),
-          "simulate: the lamp's modulation depth m in [0, 1]: intensity times 1 + m sin(2 pi f t).",
+      Row("mains_depth", "simulator", "simulate", 0,
+          Double(FlickerOptions().mains_depth, ValueRange::Between(0.0, 1.0)),
+          "simulate: the lamp's modulation depth m: intensity times 1 + m sin(2 pi f t).",
           EVFS_OPTION_FIELD(flicker.mains_depth)),
       Row("mains_region_px", "simulator", "simulate", 0, Text(""),
           "simulate: the region 'X,Y,WIDTH,HEIGHT' in pixels the lamp lights; empty: the whole "
           "frame.",
           Unbound()),
-      Row("frame_gain", "simulator", "simulate", 0, Double(FrameEffectsOptions().gain),
+      Row("frame_gain", "simulator", "simulate", 0,
+          Double(FrameEffectsOptions().gain, ValueRange::Above(0.0)),
           "simulate: gain on the written frames before they clip at white (saturation).",
           EVFS_OPTION_FIELD(frame_effects.gain)),
-      Row("read_noise_dn", "simulator", "simulate", 0, Double(FrameEffectsOptions().read_noise_dn),
+      Row("read_noise_dn", "simulator", "simulate", 0,
+          Double(FrameEffectsOptions().read_noise_dn, ValueRange::AtLeast(0.0)),
           "simulate: std dev of the frames' read noise in 8-bit DN.",
           EVFS_OPTION_FIELD(frame_effects.read_noise_dn)),
-      Row("fpn_offset_dn", "simulator", "simulate", 0, Double(FrameEffectsOptions().fpn_offset_dn),
+      Row("fpn_offset_dn", "simulator", "simulate", 0,
+          Double(FrameEffectsOptions().fpn_offset_dn, ValueRange::AtLeast(0.0)),
           "simulate: std dev of the frames' per-pixel offset (fixed pattern) in 8-bit DN.",
           EVFS_OPTION_FIELD(frame_effects.fpn_offset_dn)),
       Row("fpn_gain_sigma", "simulator", "simulate", 0,
-          Double(FrameEffectsOptions().fpn_gain_sigma),
+          Double(FrameEffectsOptions().fpn_gain_sigma, ValueRange::From(0.0, 1.0)),
           "simulate: std dev of the frames' per-pixel relative gain (fixed pattern).",
           EVFS_OPTION_FIELD(frame_effects.fpn_gain_sigma)),
       Row("progress", "progress", "reconstruct", kNotInFingerprint, Bool(false),
           "Print a line per solver iteration even when stderr is not a terminal (it slows a solve "
           "split into independent parts).",
           Unbound()),
-      Row("progress_interval_s", "progress", "*", kNotInFingerprint, Double(5.0),
+      Row("progress_interval_s", "progress", "*", kNotInFingerprint,
+          Double(5.0, ValueRange::AtLeast(0.0)),
           "While a command runs, a line on stderr (stage, iteration, elapsed time) every this many "
           "seconds, terminal or not; 0: none.",
           Unbound()),
@@ -693,6 +747,13 @@ void OptionValues::Set(const std::string& name, OptionValue value) {
   const auto it = values_.find(name);
   CHECK(it != values_.end()) << "no option --" << name;
   CHECK_EQ(it->second.index(), value.index()) << "--" << name << ": a value of another type";
+  const ValueRange& range = FindEvfsOption(name)->range;
+  const std::optional<double> number = NumberOf(value);
+  if (number && !range.Contains(*number)) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.9g", *number);
+    throw InvalidArgumentError("--" + name + " must be " + range.Text() + ", not " + text);
+  }
   it->second = std::move(value);
   given_.insert(name);
 }

@@ -1,6 +1,7 @@
 // The options of `evfs`, each declared once (COLMAP's OptionManager binds each option to its
-// member the same way): name, help group, the commands that read it, default, help text, the
-// Python key it is and the field of the requests it sets. From this one table come
+// member the same way): name, help group, the commands that read it, default, the values it
+// accepts, help text, the Python key it is and the field of the requests it sets. From this one
+// table come
 //
 //   * the command-line flags (RegisterEvfsFlags: gflags parses them, their help is the row's),
 //   * the flag rows of `evfs --help` (EvfsFlagHelp, app/evfs_help.h),
@@ -27,6 +28,7 @@
 #include "evfs/app/command_line_help.h"
 #include "evfs/app/reconstruct_job.h"
 #include "evfs/app/video_job.h"
+#include "evfs/core/value_range.h"
 #include "evfs/events/flicker.h"
 #include "evfs/events/frame_effects.h"
 #include "evfs/events/simulator.h"
@@ -69,7 +71,10 @@ struct OptionDefinition {
   std::string commands;  // the commands that read it, separated by spaces; "*" for all
   unsigned uses = 0;     // OptionUse bits
   OptionValue default_value;
-  std::string help;  // the flag's help text
+  /// The values a numeric option accepts (a value outside never enters OptionValues); Any()
+  /// for a text or a switch.
+  ValueRange range = ValueRange::Any();
+  std::string help;  // the flag's help text, ending with the range of a bounded option
   /// The field of EvfsSettings it sets ("reconstruct.binning.max_latent_frames"); "" for an
   /// option a command reads itself (--out, --progress).
   std::string field;
@@ -106,7 +111,8 @@ class OptionValues {
   /// Every option at its default.
   OptionValues();
 
-  /// Gives option `name` (which must be registered, and `value` of its type).
+  /// Gives option `name` (which must be registered, and `value` of its type). Throws
+  /// InvalidArgumentError for a value outside the option's range.
   void Set(const std::string& name, OptionValue value);
   /// Whether `name` was given rather than left at its default.
   bool Given(const std::string& name) const { return given_.count(name) > 0; }

@@ -23,8 +23,6 @@ using Clock = std::chrono::steady_clock;
 
 // Most frames --fps may resample the latent video to (a runaway rate would fill memory).
 constexpr double kMaxOutputFrames = 10000;
-// Longest --exposure_s: keeps t +- exposure / 2 far inside int64 nanoseconds.
-constexpr double kMaxExposureS = 3600.0;
 
 void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   const int count = static_cast<int>(source.frames().size());
@@ -123,9 +121,9 @@ void CheckRequest(const ReconstructRequest& request) {
   if (request.fps < 0.0 || !std::isfinite(request.fps)) {
     throw InvalidArgumentError("--fps must be positive (or 0 for the latent timeline)");
   }
-  if (!(request.exposure_s >= 0.0 && request.exposure_s <= kMaxExposureS)) {
+  if (!(request.exposure_s >= 0.0 && request.exposure_s <= kMaxDurationS)) {
     throw InvalidArgumentError("--exposure_s must be between 0 and " +
-                               std::to_string(static_cast<int>(kMaxExposureS)) + " seconds");
+                               std::to_string(static_cast<int>(kMaxDurationS)) + " seconds");
   }
   CheckDenoiseMode(request.denoise.mode, request.method.method);
   if (request.denoise.mode == DenoiseMode::kPnp && !request.denoise.pnp.IsValid(&error)) {

@@ -739,8 +739,8 @@ bool VideoRequest::IsValid(std::string* error) const {
                "0 (derived) or at least 1 frame per second")
       .Require(!(fps > kMaxVideoFps), "--fps",
                "at most 1e9 frames per second (output times are whole nanoseconds)")
-      .InRange("--jobs", jobs, 0, 4096)
-      .InRange("--threads", threads_per_window, 0, 4096)
+      .InRange("--jobs", jobs, 0, kMaxThreads)
+      .InRange("--threads", threads_per_window, 0, kMaxThreads)
       .Valid(method.reconstruction)
       .Valid(binning);
   return check.Passed(error);

@@ -45,6 +45,8 @@ inline constexpr double kMinVideoFps = 1.0;
 /// Highest --fps: output times are whole nanoseconds, so a faster rate has no distinct frame
 /// times (its step rounds to zero and the output clock would never advance).
 inline constexpr double kMaxVideoFps = 1e9;
+/// Most --jobs and --threads.
+inline constexpr int kMaxThreads = 4096;
 
 /// Where a video job stands, after each window.
 struct VideoProgress {

@@ -10,9 +10,6 @@
 namespace evfs {
 namespace {
 
-// Longest --exposure_s and --predict_max_s: keeps times far inside int64 nanoseconds.
-constexpr double kMaxSeconds = 3600.0;
-
 VideoWindowFrame ObservedFrame(const std::vector<FrameInfo>& frames, int index,
                                const VideoWindowOptions& options) {
   const FrameInfo& info = frames[index];
@@ -74,11 +71,11 @@ bool VideoWindowOptions::IsValid(std::string* error) const {
   OptionChecker check;
   check.Require(first >= 0, "--first", "0 or more")
       .Require(last == -1 || last >= first, "--last", "-1 (the last frame) or at least --first")
-      .Require(predict_max_s >= 0.0 && predict_max_s <= kMaxSeconds, "--predict_max_s",
+      .Require(predict_max_s >= 0.0 && predict_max_s <= kMaxDurationS, "--predict_max_s",
                "between 0 and 3600 seconds")
-      .Require(min_blur_exposure_s >= 0.0 && min_blur_exposure_s <= kMaxSeconds,
+      .Require(min_blur_exposure_s >= 0.0 && min_blur_exposure_s <= kMaxDurationS,
                "--min_blur_exposure_s", "between 0 and 3600 seconds")
-      .Require(exposure_s >= 0.0 && exposure_s <= kMaxSeconds, "--exposure_s",
+      .Require(exposure_s >= 0.0 && exposure_s <= kMaxDurationS, "--exposure_s",
                "between 0 and 3600 seconds")
       .InRange("--frame_step", frame_step, 1, 1000000);
   return check.Passed(error);

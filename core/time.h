@@ -11,6 +11,10 @@ namespace evfs {
 
 constexpr int64_t kNanosecondsPerSecond = 1000000000;
 
+/// Longest duration an option gives in seconds (an exposure, a prediction): an hour keeps every
+/// time derived from it far inside int64 nanoseconds.
+constexpr double kMaxDurationS = 3600.0;
+
 inline double NanosecondsToSeconds(int64_t t_ns) {
   return static_cast<double>(t_ns) / static_cast<double>(kNanosecondsPerSecond);
 }

@@ -179,8 +179,6 @@ int RunCalibrate() {
   Require(!Options().String("data").empty(), "calibrate needs --data=DIR or --data=FILE.h5");
   Require(!Options().String("out").empty(), "calibrate needs --out=MODEL.json");
   Require(IsEventModelFile(Options().String("out")), "calibrate: --out must name a .json file");
-  Require(Options().Int("first") >= -1 && Options().Int("last") >= -1,
-          "--first, --last: a frame number must be 0 or more");
   CalibrateRequest request;
   request.data_path = Options().String("data");
   request.first = Options().Int("first");
@@ -220,8 +218,6 @@ int RunDenoise() {
 int RunReconstruct(ProgressReporter* progress) {
   Require(!Options().String("data").empty(), "reconstruct needs --data=DIR or --data=FILE.h5");
   Require(!Options().String("out").empty(), "reconstruct needs --out=DIR");
-  Require(Options().Int("first") >= -1, "--first=" + std::to_string(Options().Int("first")) +
-                                            ": a frame number must be 0 or more");
   Require(Options().Int("first") >= 0, "reconstruct needs --first=I (a 0-based images.txt line)");
   ReconstructRequest request = ReconstructRequestFromOptions(Options(), /*with_mode=*/true);
   OutputTarget out(OutputFromFlags("reconstruct", Options().String("data")));
@@ -245,10 +241,6 @@ int RunReconstruct(ProgressReporter* progress) {
 int RunVideoCommand(ProgressReporter* progress) {
   Require(!Options().String("data").empty(), "video needs --data=DIR or --data=FILE.h5");
   Require(!Options().String("out").empty(), "video needs --out=DIR");
-  Require(Options().Int("first") >= -1, "--first=" + std::to_string(Options().Int("first")) +
-                                            ": a frame number must be 0 or more");
-  Require(Options().Int("last") >= -1,
-          "--last=" + std::to_string(Options().Int("last")) + ": a frame number must be 0 or more");
   VideoRequest request = VideoRequestFromOptions(Options());
   request.notice = [](const std::string& line) {
     std::fprintf(stderr, "evfs video: %s\n", line.c_str());
@@ -330,9 +322,6 @@ int RunVideoCommand(ProgressReporter* progress) {
 
 int RunCommand(const std::string& command) {
   SetFramePathsMayLeaveFolder(Options().Bool("allow_outside_paths"));
-  Require(std::isfinite(Options().Double("progress_interval_s")) &&
-              Options().Double("progress_interval_s") >= 0.0,
-          "--progress_interval_s must be a number of seconds, 0 or more");
   // Lines on stderr while the command runs, only when it runs long (runtime/progress.h).
   ProgressOptions progress_options;
   progress_options.prefix = "evfs " + command;
@@ -529,7 +518,14 @@ int main(int argc, char** argv) {
   // Every command runs in a worker process: a signal or a crash there leaves no unfinished
   // output (the parent removes it), and a corrupt .h5 file that crashes libhdf5 is a user error
   // (runtime/crash_guard.h). `convert --overwrite` opens the .h5 file it would replace.
+  // A value outside its option's range is refused before any work, as gflags' own errors are.
   std::string hdf5_path;
+  try {
+    evfs::Options();
+  } catch (const evfs::Error& error) {
+    std::fprintf(stderr, "evfs %s: %s\n", command.c_str(), error.what());
+    return evfs::kExitUserError;
+  }
   const evfs::OptionValues& options = evfs::Options();
   if (evfs::IsHdf5Path(options.String("data"))) {
     hdf5_path = options.String("data");

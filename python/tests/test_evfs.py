@@ -499,6 +499,11 @@ def test_bad_options(small):
         reconstruct(small, options={"bounds": 1})
     with pytest.raises(ValueError, match="option 'event_weight' must be a number, not str"):
         reconstruct(small, options={"event_weight": "0.3"})
+    # A number outside its option's range, as the command line refuses it.
+    with pytest.raises(ValueError, match=r"^--hot_pixel_factor must be >= 0, not -1$"):
+        reconstruct(small, options={"hot_pixel_factor": -1.0})
+    with pytest.raises(ValueError, match=r"^--smoothing_scale must be > 0, not nan$"):
+        reconstruct(small, options={"smoothing_scale": float("nan")})
     with pytest.raises(ValueError, match="dtype must be 'float32' or 'float64'"):
         reconstruct(small, dtype="float16")
 
@@ -525,7 +530,7 @@ def test_simulate_identical_to_cli(demo, tmp_path):
 def test_simulate_bad_input(small):
     with pytest.raises(ValueError, match=r"simulate needs at least 2 frames \(1 found\)"):
         evfs.simulate(small["frames"][:1], small["frame_times"][:1])
-    with pytest.raises(ValueError, match="simulator: "):
+    with pytest.raises(ValueError, match=r"^--threshold_pos must be > 0, not -1$"):
         evfs.simulate(small["frames"], small["frame_times"], {"threshold_pos": -1.0})
 
 

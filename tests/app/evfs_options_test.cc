@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -16,6 +18,8 @@
 
 #include "evfs/app/command_line_help.h"
 #include "evfs/app/evfs_help.h"
+#include "evfs/core/error.h"
+#include "evfs/core/option_checker.h"
 
 namespace evfs {
 namespace {
@@ -213,6 +217,191 @@ TEST(EvfsOptionsTest, BuildersSetTheBoundFields) {
   EXPECT_THROW(ReconstructRequestFromOptions(bad, false), InvalidArgumentError);
   // A command that reads no binning option is not stopped by one.
   EXPECT_NO_THROW(SimulatorFromOptions(bad));
+}
+
+// A numeric option's value of the option's own type holding `number`; false when that type
+// cannot hold it (a negative unsigned seed, an int32 beyond its range).
+bool ValueOfType(const OptionValue& like, double number, OptionValue* value) {
+  return std::visit(
+      [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::string>) {
+          return false;
+        } else {
+          if constexpr (std::is_integral_v<T>) {
+            if (!(number >= static_cast<double>(std::numeric_limits<T>::lowest()) &&
+                  number <= static_cast<double>(std::numeric_limits<T>::max()))) {
+              return false;
+            }
+          }
+          *value = static_cast<T>(number);
+          return true;
+        }
+      },
+      like);
+}
+
+bool IsIntegral(const OptionValue& value) {
+  return std::holds_alternative<int32_t>(value) || std::holds_alternative<int64_t>(value) ||
+         std::holds_alternative<uint64_t>(value);
+}
+
+// Values just inside and just outside each finite end of an option's range.
+struct RangeProbes {
+  std::vector<double> inside;
+  std::vector<double> outside;
+};
+
+RangeProbes ProbesOf(const OptionDefinition& option) {
+  const ValueRange& range = option.range;
+  const bool integral = IsIntegral(option.default_value);
+  const auto step = [&](double at) { return integral ? 1.0 : std::max(1e-9, std::abs(at) * 1e-9); };
+  RangeProbes probes;
+  const auto add_outside = [&](double value, double away) {
+    if (range.has_also() && value == range.also()) value += away;
+    probes.outside.push_back(value);
+  };
+  if (std::isfinite(range.low())) {
+    const double low = range.low();
+    probes.inside.push_back(range.low_open() ? low + step(low) : low);
+    add_outside(range.low_open() ? low : low - step(low), -step(low));
+  }
+  if (std::isfinite(range.high())) {
+    const double high = range.high();
+    probes.inside.push_back(range.high_open() ? high - step(high) : high);
+    add_outside(range.high_open() ? high : high + step(high), step(high));
+  }
+  if (range.has_also()) probes.inside.push_back(range.also());
+  return probes;
+}
+
+// Every number an option takes is declared with the values it accepts; the default is one of
+// them and the help says which.
+TEST(EvfsOptionsTest, EveryNumericOptionDeclaresItsRange) {
+  // Any number means something: a contrast threshold <= 0 is derived from the data.
+  const std::set<std::string> any_number = {"contrast_threshold"};
+  for (const OptionDefinition& option : EvfsOptions()) {
+    SCOPED_TRACE("--" + option.name);
+    OptionValue probe;
+    if (!ValueOfType(option.default_value, 0.0, &probe)) {
+      EXPECT_FALSE(option.range.Bounded()) << "a range on a text or a switch";
+      continue;
+    }
+    EXPECT_NE(option.range.Bounded(), any_number.count(option.name) > 0);
+    OptionValues values;
+    EXPECT_NO_THROW(values.Set(option.name, option.default_value)) << "the default is refused";
+    if (option.range.Bounded()) {
+      const std::string said = " Values: " + option.range.Text() + ".";
+      EXPECT_EQ(option.help.substr(option.help.size() - std::min(option.help.size(), said.size())),
+                said);
+    }
+  }
+}
+
+// A value outside its option's range is refused where it enters (the command line and Python
+// both set OptionValues), naming the flag; NaN is no number of any range.
+TEST(EvfsOptionsTest, AValueOutsideItsRangeIsRefused) {
+  int probed = 0;
+  for (const OptionDefinition& option : EvfsOptions()) {
+    SCOPED_TRACE("--" + option.name);
+    const RangeProbes probes = ProbesOf(option);
+    for (const double number : probes.outside) {
+      OptionValue value;
+      if (!ValueOfType(option.default_value, number, &value)) continue;
+      OptionValues values;
+      try {
+        values.Set(option.name, value);
+        ADD_FAILURE() << number << " accepted";
+      } catch (const InvalidArgumentError& error) {
+        EXPECT_NE(std::string(error.what()).find("--" + option.name + " must be"),
+                  std::string::npos)
+            << error.what();
+      }
+      ++probed;
+    }
+    for (const double number : probes.inside) {
+      OptionValue value;
+      if (!ValueOfType(option.default_value, number, &value)) continue;
+      OptionValues values;
+      EXPECT_NO_THROW(values.Set(option.name, value)) << number;
+    }
+    if (std::holds_alternative<double>(option.default_value)) {
+      OptionValues values;
+      EXPECT_THROW(values.Set(option.name, std::nan("")), InvalidArgumentError);
+    }
+  }
+  EXPECT_GT(probed, 60);
+}
+
+// What the library's own checks (each request's IsValid) refuse in `settings`, "" if nothing:
+// the settings as the builders hand them over (video's windows and rates from reconstruct's).
+std::string LibraryRefusal(const EvfsSettings& settings) {
+  const ReconstructRequest& reconstruct = settings.reconstruct;
+  std::string error;
+  OptionChecker check;
+  BinningOptions stacked = reconstruct.binning;
+  stacked.method = BinningOptions::Method::kStacked;
+  VideoRequest video = settings.video;
+  video.windows.first = std::max(reconstruct.first, 0);
+  video.windows.last = reconstruct.last;
+  video.windows.exposure_s = reconstruct.exposure_s;
+  video.fps = reconstruct.fps;
+  video.threads_per_window = reconstruct.method.reconstruction.solver.num_threads;
+  video.method = reconstruct.method;
+  video.binning = reconstruct.binning;
+  FlickerOptions flicker = settings.flicker;
+  flicker.led_x_px = flicker.led_y_px = 1.0;
+  check.Valid(reconstruct.method.reconstruction)
+      .Valid(stacked)
+      .Valid(reconstruct.method.adam)
+      .Valid(reconstruct.method.baseline)
+      .Valid(video)
+      .Valid(settings.simulator)
+      .Valid(flicker)
+      .Valid(settings.frame_effects);
+  check.Passed(&error);
+  return error;
+}
+
+// The table's ranges are those the library's checks hold to: set past the table (as a library
+// user sets a field), a value just outside its range is refused by the request's IsValid, and
+// one just inside is not. The options checked only by the table say why.
+TEST(EvfsOptionsTest, RangesAgreeWithTheLibrarysChecks) {
+  const std::map<std::string, std::string> table_only = {
+      {"first", "reconstruct reads -1 as unset; video from the first frame"},
+      {"truth", "-1: none; the recording's frame count bounds the rest"},
+      {"activity_radius_px", "any negative radius solves every pixel in the library"},
+      {"denoise_gate_tau", "checked when the denoiser runs (app/denoise_job.cc)"},
+      {"progress_interval_s", "read by the command itself"},
+  };
+  for (const OptionDefinition& option : EvfsOptions()) {
+    if (option.set == nullptr || !option.range.Bounded()) continue;
+    SCOPED_TRACE("--" + option.name);
+    const RangeProbes probes = ProbesOf(option);
+    for (const double number : probes.inside) {
+      OptionValue value;
+      if (!ValueOfType(option.default_value, number, &value)) continue;
+      EvfsSettings settings;
+      option.set(value, "--" + option.name, &settings);
+      EXPECT_EQ(LibraryRefusal(settings), "") << number << " is inside the table's range";
+    }
+    int library_refused = 0;
+    int outside = 0;
+    for (const double number : probes.outside) {
+      OptionValue value;
+      if (!ValueOfType(option.default_value, number, &value)) continue;
+      EvfsSettings settings;
+      option.set(value, "--" + option.name, &settings);
+      ++outside;
+      if (!LibraryRefusal(settings).empty()) {
+        ++library_refused;
+      } else {
+        EXPECT_TRUE(table_only.count(option.name)) << number << " is outside the table's range";
+      }
+    }
+    // The list stays true: an option it names passes some value the table refuses.
+    if (table_only.count(option.name)) EXPECT_LT(library_refused, outside) << "checked twice";
+  }
 }
 
 // The field names of `struct name` in `header`: the last word before '=', ';' or '{' of each

@@ -166,7 +166,7 @@ TEST(EvfsCli, UserErrorsExitWithStatus2AndLeaveNoOutput) {
        "--spatial_tv"},
       // Values that used to overflow the nanosecond timeline or resample forever.
       {"reconstruct --data=" + data + " --mode=deblur --first=1 --exposure_s=1e30 --out=" + out,
-       "--exposure_s must be between 0 and 3600 seconds"},
+       "--exposure_s must be in [0, 3600], not 1e+30"},
       {"reconstruct --data=" + data + " --mode=predict --first=0 --fps=1e300 --out=" + out,
        "--fps would resample"},
   };

@@ -111,14 +111,15 @@ TEST(EvfsFailure, BadSolverAndFrameFlagsNameTheFlag) {
   const std::string data = WriteSyntheticFolder(scratch.string());
   const std::string reconstruct =
       "reconstruct --data=" + data + " --mode=interpolate --first=0 --last=1 --out=" + out.string();
-  ExpectUserError(RunEvfs(reconstruct + " --alpha=1e308"), "--alpha must be at most 1e6", out);
-  ExpectUserError(RunEvfs(reconstruct + " --threads=0"), "--threads must be 1 or more", out);
+  ExpectUserError(RunEvfs(reconstruct + " --alpha=1e308"), "--alpha must be <= 1000000, not 1e+308",
+                  out);
+  ExpectUserError(RunEvfs(reconstruct + " --threads=0"), "--threads must be in [1, 4096], not 0",
+                  out);
   ExpectUserError(
       RunEvfs("reconstruct --data=" + data + " --mode=predict --first=-5 --out=" + out.string()),
-      "--first=-5: a frame number must be 0 or more", out);
+      "--first must be -1, or >= 0, not -5", out);
   const std::string video = "video --data=" + data + " --out=" + out.string();
-  ExpectUserError(RunEvfs(video + " --first=-5"), "--first=-5: a frame number must be 0 or more",
-                  out);
+  ExpectUserError(RunEvfs(video + " --first=-5"), "--first must be -1, or >= 0, not -5", out);
   const CommandResult slow = RunEvfs(video + " --fps=1e-3");
   ExpectUserError(slow, "--fps must be 0 (derived) or at least 1 frame per second", out);
   EXPECT_EQ(slow.output.find("windows"), std::string::npos) << "solved first: " << slow.output;
