@@ -1,7 +1,5 @@
 #include "evfs/app/video_job.h"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -776,44 +774,6 @@ std::string VideoProgressLine(const VideoProgress& progress) {
       solved > 0 ? (std::to_string(static_cast<int>(std::ceil(eta_s))) + " s").c_str() : "?",
       events_per_s / 1000.0);
   return line + text;
-}
-
-int64_t AddressSpaceLimit() {
-  rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 0;
-  return static_cast<int64_t>(std::min<rlim_t>(limit.rlim_cur, INT64_MAX));
-}
-
-int CapVideoJobs(int jobs, int windows, int cores, int threads_per_window, int64_t pixels,
-                 int64_t address_space_bytes, std::string* why) {
-  int capped = std::max(jobs, 1);
-  const auto lower = [&](int64_t most, const std::string& reason) {
-    most = std::max<int64_t>(most, 1);
-    if (capped > most) {
-      capped = static_cast<int>(most);
-      *why = reason;
-    }
-  };
-  lower(static_cast<int64_t>(cores) * kMaxJobsPerCore,
-        "at most " + std::to_string(kMaxJobsPerCore) + " per hardware thread (" +
-            std::to_string(cores) + ")");
-  if (address_space_bytes > 0) {
-    // Each job reserves its threads' stacks and holds its window's frames, events and problem;
-    // the rest of the address space is the process' own (libraries, the recording's index).
-    rlimit stack{};
-    int64_t stack_bytes = kDefaultThreadStackBytes;
-    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY) {
-      stack_bytes = static_cast<int64_t>(stack.rlim_cur);
-    }
-    const int64_t per_job = std::max(threads_per_window, 1) * stack_bytes +
-                            std::max<int64_t>(pixels, 1) * kWindowBytesPerPixel;
-    lower(address_space_bytes / 2 / per_job,
-          "the address space limit (ulimit -v, " + std::to_string(address_space_bytes >> 20) +
-              " MiB) leaves room for that many windows' stacks and working memory");
-  }
-  if (windows > 0)
-    lower(windows, "there are only " + std::to_string(windows) + " windows to solve");
-  return capped;
 }
 
 VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,

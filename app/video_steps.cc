@@ -1,5 +1,7 @@
 #include "evfs/app/video_steps.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -142,6 +144,44 @@ std::string WorkFolderFingerprint(const std::string& data_path, double fps,
               << "settings " << settings << "\n"
               << PlanText(windows, clock);
   return fingerprint.str();
+}
+
+int64_t AddressSpaceLimit() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 0;
+  return static_cast<int64_t>(std::min<rlim_t>(limit.rlim_cur, INT64_MAX));
+}
+
+int CapVideoJobs(int jobs, int windows, int cores, int threads_per_window, int64_t pixels,
+                 int64_t address_space_bytes, std::string* why) {
+  int capped = std::max(jobs, 1);
+  const auto lower = [&](int64_t most, const std::string& reason) {
+    most = std::max<int64_t>(most, 1);
+    if (capped > most) {
+      capped = static_cast<int>(most);
+      *why = reason;
+    }
+  };
+  lower(static_cast<int64_t>(cores) * kMaxJobsPerCore,
+        "at most " + std::to_string(kMaxJobsPerCore) + " per hardware thread (" +
+            std::to_string(cores) + ")");
+  if (address_space_bytes > 0) {
+    // Each job reserves its threads' stacks and holds its window's frames, events and problem;
+    // the rest of the address space is the process' own (libraries, the recording's index).
+    rlimit stack{};
+    int64_t stack_bytes = kDefaultThreadStackBytes;
+    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY) {
+      stack_bytes = static_cast<int64_t>(stack.rlim_cur);
+    }
+    const int64_t per_job = std::max(threads_per_window, 1) * stack_bytes +
+                            std::max<int64_t>(pixels, 1) * kWindowBytesPerPixel;
+    lower(address_space_bytes / 2 / per_job,
+          "the address space limit (ulimit -v, " + std::to_string(address_space_bytes >> 20) +
+              " MiB) leaves room for that many windows' stacks and working memory");
+  }
+  if (windows > 0)
+    lower(windows, "there are only " + std::to_string(windows) + " windows to solve");
+  return capped;
 }
 
 VideoSchedule ScheduleVideo(int requested_jobs, int requested_threads, int pending_windows,

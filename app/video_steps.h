@@ -61,6 +61,23 @@ std::string WorkFolderFingerprint(const std::string& data_path, double fps,
                                   const std::vector<VideoWindow>& windows,
                                   const OutputClock& clock);
 
+/// Most --jobs per hardware thread: more only adds threads waiting for a core.
+constexpr int kMaxJobsPerCore = 4;
+/// The stack a thread reserves when RLIMIT_STACK is unlimited (glibc's default).
+constexpr int64_t kDefaultThreadStackBytes = int64_t{8} << 20;
+/// Working memory of one window per sensor pixel: its latent frames, event frames and problem
+/// (a rough upper bound for the windows evfs video plans, tens of latent steps).
+constexpr int64_t kWindowBytesPerPixel = 4096;
+
+/// The jobs (windows solved at once) `jobs` asked for, lowered to: kMaxJobsPerCore × `cores`,
+/// the jobs whose thread stacks and window memory fit in half of `address_space_bytes` (0: no
+/// limit), and `windows` (when positive). Sets `why` to the reason of the last lowering.
+int CapVideoJobs(int jobs, int windows, int cores, int threads_per_window, int64_t pixels,
+                 int64_t address_space_bytes, std::string* why);
+
+/// The process' address space limit (RLIMIT_AS) in bytes; 0 when unlimited.
+int64_t AddressSpaceLimit();
+
 /// How the windows are solved in this process.
 struct VideoSchedule {
   int jobs = 1;                 // windows solved at once
