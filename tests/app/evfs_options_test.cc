@@ -400,7 +400,9 @@ TEST(EvfsOptionsTest, RangesAgreeWithTheLibrarysChecks) {
       }
     }
     // The list stays true: an option it names passes some value the table refuses.
-    if (table_only.count(option.name)) EXPECT_LT(library_refused, outside) << "checked twice";
+    if (table_only.count(option.name)) {
+      EXPECT_LT(library_refused, outside) << "checked twice";
+    }
   }
 }
 
