@@ -59,7 +59,10 @@ def main():
     print("| window | " + " | ".join("k = %g" % k for k in scales) + " | k for 68 % |")
     print("|---" * (len(scales) + 2) + "|")
     for out in args.out_dirs:
-        summary = json.load(open(os.path.join(out, "summary.json")))
+        summary_path = os.path.join(out, "summary.json")
+        if not os.path.isfile(summary_path):
+            raise SystemExit(out + ": no summary.json (not a folder evfs reconstruct wrote)")
+        summary = json.load(open(summary_path))
         truth_info = summary.get("truth")
         if not truth_info:
             raise SystemExit(out + ": summary.json has no truth (run reconstruct with --truth)")
