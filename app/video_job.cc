@@ -6,18 +6,16 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <sstream>
-#include <string_view>
 #include <thread>
 
 #include "evfs/app/run_report.h"
 #include "evfs/app/video_steps.h"
+#include "evfs/app/video_work_folder.h"
 #include "evfs/core/error.h"
 #include "evfs/core/metrics.h"
 #include "evfs/core/option_checker.h"
@@ -37,10 +35,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
-// The marker of a work folder: its first line, then the run's settings.
-constexpr char kWorkMarkerFile[] = ".evfs-video-work";
-constexpr char kWorkMarkerTitle[] = "evfs video work folder";
-
 // JSON has no inf or nan: they become null.
 Json Number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
 
@@ -48,167 +42,6 @@ std::string FrameName(int64_t n) {
   char name[32];
   std::snprintf(name, sizeof(name), "%06lld", static_cast<long long>(n));
   return name;
-}
-
-// Writes `text` to `path` under a temporary name, then renames it: the file appears whole.
-void WriteFileAtomically(const fs::path& path, const std::string& text) {
-  const fs::path temporary = path.string() + ".tmp";
-  std::ofstream file(temporary);
-  file << text;
-  file.close();
-  std::error_code error;
-  if (!file || (fs::rename(temporary, path, error), error)) {
-    throw InputError(InputError::Kind::kUnwritable, path.string(), 0, "cannot write it");
-  }
-}
-
-std::string ReadWholeFile(const fs::path& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-bool IsOwnWorkFolder(const fs::path& folder) {
-  std::error_code error;
-  if (fs::is_symlink(folder, error) || !fs::is_directory(folder, error)) return false;
-  const fs::path marker = folder / kWorkMarkerFile;
-  if (fs::is_symlink(marker, error) || !fs::is_regular_file(marker, error)) return false;
-  std::ifstream file(marker);
-  std::string title;
-  std::getline(file, title);
-  return title == kWorkMarkerTitle;
-}
-
-// Whether `name` is a run of decimal digits followed by `suffix`.
-bool DigitsThen(std::string_view name, std::string_view suffix) {
-  if (name.size() <= suffix.size() || name.substr(name.size() - suffix.size()) != suffix) {
-    return false;
-  }
-  const std::string_view digits = name.substr(0, name.size() - suffix.size());
-  return std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
-}
-
-// Whether `relative` (inside a work folder, '/'-separated) is a path a video run writes there:
-// the marker, frames/, confidence/ and windows/ with their files, and each file's temporary name.
-bool IsWorkFolderPath(const std::string& relative, bool is_folder) {
-  if (is_folder) return relative == "frames" || relative == "confidence" || relative == "windows";
-  std::string_view name = relative;
-  constexpr std::string_view kTemporary = ".tmp";
-  if (name.size() > kTemporary.size() && name.substr(name.size() - kTemporary.size()) == kTemporary)
-    name.remove_suffix(kTemporary.size());
-  if (name == kWorkMarkerFile) return true;
-  for (const std::string_view folder : {"frames/", "confidence/"}) {
-    if (name.substr(0, folder.size()) == folder) {
-      const std::string_view file = name.substr(folder.size());
-      return DigitsThen(file, ".png") || DigitsThen(file, ".tmp.png");
-    }
-  }
-  constexpr std::string_view kWindows = "windows/";
-  return name.substr(0, kWindows.size()) == kWindows &&
-         DigitsThen(name.substr(kWindows.size()), ".json");
-}
-
-// The paths in a work folder that a video run does not write ("REL", "REL/" for a folder),
-// and the own files when `own_files` is given. Links are listed, never followed.
-std::vector<std::string> WorkFolderForeign(const fs::path& folder,
-                                           std::vector<fs::path>* own_files = nullptr) {
-  std::vector<std::string> foreign;
-  std::error_code error;
-  fs::recursive_directory_iterator it(folder, fs::directory_options::none, error);
-  for (; !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
-    const std::string relative = it->path().lexically_relative(folder).generic_string();
-    std::error_code status_error;
-    const fs::file_status status = it->symlink_status(status_error);
-    const bool is_folder = fs::is_directory(status);
-    if (IsWorkFolderPath(relative, is_folder) && (is_folder || fs::is_regular_file(status))) {
-      if (!is_folder && own_files != nullptr) own_files->push_back(it->path());
-      continue;
-    }
-    foreign.push_back(relative + (is_folder ? "/" : ""));
-    if (is_folder) it.disable_recursion_pending();
-  }
-  std::sort(foreign.begin(), foreign.end());
-  if (error) foreign.push_back("(a folder that cannot be listed: " + error.message() + ")");
-  return foreign;
-}
-
-// Removes what a video run wrote in its work folder, and the folder when nothing else is left
-// in it: what the user put there stays.
-void RemoveWorkFolder(const fs::path& folder) {
-  std::vector<fs::path> own_files;
-  std::error_code error;
-  if (WorkFolderForeign(folder, &own_files).empty()) {
-    fs::remove_all(folder, error);
-    return;
-  }
-  for (const fs::path& file : own_files) fs::remove(file, error);
-  for (const char* sub : {"frames", "confidence", "windows", ""}) {
-    fs::remove(folder / sub, error);  // if empty
-  }
-}
-
-// "a, b, c (and 4 more)".
-std::string NameSome(const std::vector<std::string>& paths) {
-  constexpr size_t kNamed = 3;
-  std::string names;
-  for (size_t i = 0; i < paths.size() && i < kNamed; ++i) names += (i > 0 ? ", " : "") + paths[i];
-  if (paths.size() > kNamed) names += " (and " + std::to_string(paths.size() - kNamed) + " more)";
-  return names;
-}
-
-// Makes the work folder ready and returns the records of the windows it already holds (only
-// with `resume`, and only when the settings match).
-std::map<int, Json> PrepareWorkFolder(const fs::path& folder, const std::string& fingerprint,
-                                      bool resume) {
-  std::error_code error;
-  const bool exists = fs::exists(fs::symlink_status(folder, error));
-  if (exists && !IsOwnWorkFolder(folder)) {
-    throw InvalidArgumentError(folder.string() +
-                               " exists and is not an evfs video work folder: evfs keeps "
-                               "unfinished windows there; move it away");
-  }
-  if (exists) {
-    // A work folder is reused or replaced whole: nothing the user added may be mixed in or lost.
-    const std::vector<std::string> foreign = WorkFolderForeign(folder);
-    if (!foreign.empty()) {
-      throw InvalidArgumentError(folder.string() +
-                                 " (the work folder of this video) holds what "
-                                 "evfs did not write: " +
-                                 NameSome(foreign) + "; move that away");
-    }
-  }
-  const std::string marker_text = std::string(kWorkMarkerTitle) + "\n" + fingerprint;
-  std::map<int, Json> done;
-  if (exists && resume) {
-    if (ReadWholeFile(folder / kWorkMarkerFile) != marker_text) {
-      throw InvalidArgumentError(
-          "--resume: the interrupted run in " + folder.string() +
-          " had other settings or data; run again without --resume to start over");
-    }
-    for (const auto& entry : fs::directory_iterator(folder / "windows", error)) {
-      if (entry.path().extension() != ".json") continue;
-      try {
-        Json record = Json::parse(ReadWholeFile(entry.path()));
-        const int index = record.at("index").get<int>();
-        done[index] = std::move(record);
-      } catch (const std::exception&) {
-        // An unreadable record is a window to solve again.
-      }
-    }
-    return done;
-  }
-  error.clear();
-  if (exists) fs::remove_all(folder, error);
-  if (error || !fs::create_directory(folder, error) || error ||
-      !fs::create_directory(folder / "frames", error) ||
-      !fs::create_directory(folder / "confidence", error) ||
-      !fs::create_directory(folder / "windows", error)) {
-    throw InputError(InputError::Kind::kUnwritable, folder.string(), 0,
-                     "cannot create the work folder: " + error.message());
-  }
-  WriteFileAtomically(folder / kWorkMarkerFile, marker_text);
-  return done;
 }
 
 // Serialises reads of the recording (DataSource is not thread-safe) and names bad frames.
@@ -565,7 +398,7 @@ int SolveWindows(const std::vector<VideoWindow>& windows, const std::vector<int>
   const VideoDistribution* distribution = request.distribution;
   if (distribution != nullptr && distribution->coordinator) {
     distribution->serve(pending);
-    *records = PrepareWorkFolder(context.work, fingerprint, /*resume=*/true);
+    *records = PrepareVideoWorkFolder(context.work, fingerprint, /*resume=*/true);
     for (const int index : pending) {
       if (records->count(index) != 0)
         progress->events_done += (*records)[index]["events"].get<int64_t>();
@@ -744,18 +577,6 @@ bool VideoRequest::IsValid(std::string* error) const {
   return check.Passed(error);
 }
 
-std::string VideoWorkFolder(const std::string& out_path) {
-  const fs::path out = fs::path(out_path).lexically_normal();
-  const fs::path name = out.has_filename() ? out.filename() : out.parent_path().filename();
-  const fs::path parent = out.has_filename() ? out.parent_path() : out.parent_path().parent_path();
-  return (parent / ("." + name.string() + ".evfs-video-work")).string();
-}
-
-void RemoveVideoWorkFolder(const std::string& out_path) {
-  const fs::path folder = VideoWorkFolder(out_path);
-  if (IsOwnWorkFolder(folder)) RemoveWorkFolder(folder);
-}
-
 std::string VideoProgressLine(const VideoProgress& progress) {
   constexpr int kBarWidth = 20;
   const int total = std::max(progress.windows_total, 1);
@@ -821,14 +642,14 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   const bool worker = request.distribution != nullptr && !request.distribution->coordinator;
   // A worker process writes into the work folder its coordinator prepared.
   std::map<int, Json> records =
-      worker ? std::map<int, Json>() : PrepareWorkFolder(work, fingerprint, request.resume);
+      worker ? std::map<int, Json>() : PrepareVideoWorkFolder(work, fingerprint, request.resume);
   // The work folder outlives a signal (that is what --resume is for), not an error: a run that
   // failed leaves nothing behind.
   struct RemoveOnError {
     fs::path folder;
     bool armed = true;
     ~RemoveOnError() {
-      if (armed && IsOwnWorkFolder(folder)) RemoveWorkFolder(folder);
+      if (armed && IsVideoWorkFolder(folder)) ClearVideoWorkFolder(folder);
     }
   } remove_on_error{work, !worker};
   records =

@@ -9,7 +9,7 @@
 // an output time on an observed frame reproduces that frame exactly and windows meet there.
 //
 // Resuming. Windows are written into a work folder beside the output, ".NAME.evfs-video-work"
-// (VideoWorkFolder), marked as evfs's by the file .evfs-video-work, which holds the run's
+// (app/video_work_folder.h), marked as evfs's by the file .evfs-video-work, which holds the run's
 // settings. A window's frames are written under temporary names and renamed; its record
 // (windows/WWWWWW.json) is written last, the same way, so a window with a record is complete.
 // Unlike an OutputTarget's staging folder, the work folder survives a signal; `--resume`
@@ -126,18 +126,12 @@ struct VideoResult {
   double mean_within_sigma = 0.0;
 };
 
-/// The work folder of the video written to `out_path` (absolute, as OutputTarget::path()).
-std::string VideoWorkFolder(const std::string& out_path);
-
 /// Runs the job: windows into the work folder of `out_path`, then frames/, timestamps.txt,
 /// summary.json, video.mp4 (and preview.mp4) into `staging` (an OutputTarget's staging folder,
 /// for `out_path`). Throws evfs::Error for bad options or input, InvalidArgumentError when the
 /// work folder's path holds something evfs did not mark as its own.
 VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                      const std::string& staging);
-
-/// Deletes the work folder of `out_path` (after its output was committed), if evfs marked it.
-void RemoveVideoWorkFolder(const std::string& out_path);
 
 /// One progress line: "[#####.....] 5/10 windows, 12.3 s, ETA 12 s, 41.2 k events/s".
 std::string VideoProgressLine(const VideoProgress& progress);

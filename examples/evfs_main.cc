@@ -44,6 +44,7 @@
 #include "evfs/app/version_report.h"
 #include "evfs/app/video_job.h"
 #include "evfs/app/video_mpi.h"
+#include "evfs/app/video_work_folder.h"
 #include "evfs/core/enum_names.h"
 #include "evfs/core/error.h"
 #include "evfs/core/time.h"

@@ -25,6 +25,7 @@
 #include "evfs/app/calibrate_job.h"
 #include "evfs/app/reconstruct_job.h"
 #include "evfs/app/video_job.h"
+#include "evfs/app/video_work_folder.h"
 #include "evfs/core/error.h"
 #include "evfs/core/event_stream.h"
 #include "evfs/core/time.h"
