@@ -750,9 +750,8 @@ void OptionValues::Set(const std::string& name, OptionValue value) {
   const ValueRange& range = FindEvfsOption(name)->range;
   const std::optional<double> number = NumberOf(value);
   if (number && !range.Contains(*number)) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%.9g", *number);
-    throw InvalidArgumentError("--" + name + " must be " + range.Text() + ", not " + text);
+    throw InvalidArgumentError("--" + name + " must be " + range.Text() + ", not " +
+                               RangeNumberText(*number));
   }
   it->second = std::move(value);
   given_.insert(name);

@@ -649,7 +649,7 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
     fs::path folder;
     bool armed = true;
     ~RemoveOnError() {
-      if (armed && IsVideoWorkFolder(folder)) ClearVideoWorkFolder(folder);
+      if (armed) ClearVideoWorkFolder(folder);
     }
   } remove_on_error{work, !worker};
   records =

@@ -113,6 +113,7 @@ bool IsVideoWorkFolder(const fs::path& folder) {
 }
 
 void ClearVideoWorkFolder(const fs::path& folder) {
+  if (!IsVideoWorkFolder(folder)) return;
   std::vector<fs::path> own_files;
   std::error_code error;
   if (WorkFolderForeign(folder, &own_files).empty()) {
@@ -186,8 +187,7 @@ std::string VideoWorkFolder(const std::string& out_path) {
 }
 
 void RemoveVideoWorkFolder(const std::string& out_path) {
-  const fs::path folder = VideoWorkFolder(out_path);
-  if (IsVideoWorkFolder(folder)) ClearVideoWorkFolder(folder);
+  ClearVideoWorkFolder(VideoWorkFolder(out_path));
 }
 
 }  // namespace evfs

@@ -37,7 +37,8 @@ std::map<int, VideoWindowRecord> PrepareVideoWorkFolder(const std::filesystem::p
 /// Whether `folder` is a work folder evfs marked (not a link, the marker a regular file).
 bool IsVideoWorkFolder(const std::filesystem::path& folder);
 
-/// Removes what a video run wrote in `folder`, and the folder when nothing else is left in it.
+/// Removes what a video run wrote in `folder`, and the folder when nothing else is left in it;
+/// nothing when `folder` is not a work folder evfs marked (IsVideoWorkFolder).
 void ClearVideoWorkFolder(const std::filesystem::path& folder);
 
 /// Deletes the work folder of `out_path` (after its output was committed), if evfs marked it.

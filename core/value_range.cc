@@ -18,7 +18,7 @@ std::string RangeNumberText(double value) {
   if (std::abs(value) < 1e7 && value == std::floor(value)) {
     std::snprintf(text, sizeof(text), "%.0f", value);
   } else {
-    std::snprintf(text, sizeof(text), "%g", value);
+    std::snprintf(text, sizeof(text), "%.9g", value);
   }
   return text;
 }

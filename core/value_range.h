@@ -85,7 +85,8 @@ class ValueRange {
   bool has_also_ = false;
 };
 
-/// A number as a message shows it: "3600", "0.5", "1e+06".
+/// A number as a message shows it: "3600", "0.5", "1000000.5", "1e+30" (a whole number below
+/// 1e7 in full, any other to 9 significant digits).
 std::string RangeNumberText(double value);
 
 }  // namespace evfs

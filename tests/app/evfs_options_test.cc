@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "evfs/app/command_line_help.h"
@@ -247,9 +248,11 @@ bool IsIntegral(const OptionValue& value) {
 }
 
 // Values just inside and just outside each finite end of an option's range.
+// Each probe is a number and the option's value holding it; numbers the option's type cannot
+// hold (a negative unsigned seed) are left out.
 struct RangeProbes {
-  std::vector<double> inside;
-  std::vector<double> outside;
+  std::vector<std::pair<double, OptionValue>> inside;
+  std::vector<std::pair<double, OptionValue>> outside;
 };
 
 RangeProbes ProbesOf(const OptionDefinition& option) {
@@ -257,21 +260,25 @@ RangeProbes ProbesOf(const OptionDefinition& option) {
   const bool integral = IsIntegral(option.default_value);
   const auto step = [&](double at) { return integral ? 1.0 : std::max(1e-9, std::abs(at) * 1e-9); };
   RangeProbes probes;
+  const auto add = [&](double number, std::vector<std::pair<double, OptionValue>>* to) {
+    OptionValue value;
+    if (ValueOfType(option.default_value, number, &value)) to->emplace_back(number, value);
+  };
   const auto add_outside = [&](double value, double away) {
     if (range.has_also() && value == range.also()) value += away;
-    probes.outside.push_back(value);
+    add(value, &probes.outside);
   };
   if (std::isfinite(range.low())) {
     const double low = range.low();
-    probes.inside.push_back(range.low_open() ? low + step(low) : low);
+    add(range.low_open() ? low + step(low) : low, &probes.inside);
     add_outside(range.low_open() ? low : low - step(low), -step(low));
   }
   if (std::isfinite(range.high())) {
     const double high = range.high();
-    probes.inside.push_back(range.high_open() ? high - step(high) : high);
+    add(range.high_open() ? high - step(high) : high, &probes.inside);
     add_outside(range.high_open() ? high : high + step(high), step(high));
   }
-  if (range.has_also()) probes.inside.push_back(range.also());
+  if (range.has_also()) add(range.also(), &probes.inside);
   return probes;
 }
 
@@ -305,9 +312,7 @@ TEST(EvfsOptionsTest, AValueOutsideItsRangeIsRefused) {
   for (const OptionDefinition& option : EvfsOptions()) {
     SCOPED_TRACE("--" + option.name);
     const RangeProbes probes = ProbesOf(option);
-    for (const double number : probes.outside) {
-      OptionValue value;
-      if (!ValueOfType(option.default_value, number, &value)) continue;
+    for (const auto& [number, value] : probes.outside) {
       OptionValues values;
       try {
         values.Set(option.name, value);
@@ -319,9 +324,7 @@ TEST(EvfsOptionsTest, AValueOutsideItsRangeIsRefused) {
       }
       ++probed;
     }
-    for (const double number : probes.inside) {
-      OptionValue value;
-      if (!ValueOfType(option.default_value, number, &value)) continue;
+    for (const auto& [number, value] : probes.inside) {
       OptionValues values;
       EXPECT_NO_THROW(values.Set(option.name, value)) << number;
     }
@@ -378,18 +381,14 @@ TEST(EvfsOptionsTest, RangesAgreeWithTheLibrarysChecks) {
     if (option.set == nullptr || !option.range.Bounded()) continue;
     SCOPED_TRACE("--" + option.name);
     const RangeProbes probes = ProbesOf(option);
-    for (const double number : probes.inside) {
-      OptionValue value;
-      if (!ValueOfType(option.default_value, number, &value)) continue;
+    for (const auto& [number, value] : probes.inside) {
       EvfsSettings settings;
       option.set(value, "--" + option.name, &settings);
       EXPECT_EQ(LibraryRefusal(settings), "") << number << " is inside the table's range";
     }
     int library_refused = 0;
     int outside = 0;
-    for (const double number : probes.outside) {
-      OptionValue value;
-      if (!ValueOfType(option.default_value, number, &value)) continue;
+    for (const auto& [number, value] : probes.outside) {
       EvfsSettings settings;
       option.set(value, "--" + option.name, &settings);
       ++outside;
