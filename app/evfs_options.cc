@@ -322,6 +322,13 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           Double(ObjectiveOptions().temporal_tv_weight, ValueRange::AtLeast(0.0)),
           "lambda_t: weight of temporal total variation.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.temporal_tv_weight)),
+      Row("log_temporal_tv_reversals", "model", "reconstruct video", kReconstructKey,
+          Int32(ObjectiveOptions().log_temporal_tv_reversals, ValueRange::AtLeast(0)),
+          "Pixels whose events reverse polarity at least this many times in the window (a "
+          "flickering light) get temporal TV in g = log(H + b), where a brightening step and the "
+          "darkening one that undoes it cost alike; |dH| makes them drift dark. 0: |dH| "
+          "everywhere.",
+          EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.log_temporal_tv_reversals)),
       Row("alpha", "model", "reconstruct video", kReconstructKey,
           Double(0.0, ValueRange::AtMost(ObjectiveOptions::kMaxAlpha)),
           "alpha of tanh(alpha * dg); 0 derives it from the data's contrast threshold (printed).",

@@ -387,6 +387,7 @@ Json ModelJson(const ObjectiveOptions& objective, const ReconstructionSummary& s
   json["event_weight"] = Number(objective.event_weight);
   json["spatial_tv_weight"] = Number(objective.spatial_tv_weight);
   json["temporal_tv_weight"] = Number(objective.temporal_tv_weight);
+  json["log_temporal_tv_reversals"] = objective.log_temporal_tv_reversals;
   json["spatial_tv"] = SpatialTvName(objective.spatial_tv);
   json["shared_structure_tv"] = objective.shared_structure_tv;
   json["smoothing_scale"] = Number(objective.smoothing_scale);
@@ -422,6 +423,7 @@ void AddProblem(const ReconstructionOptions& options, const ProblemStatistics& p
       {"event_residuals", problem.event_residuals},
       {"spatial_tv_residuals", problem.spatial_tv_residuals},
       {"temporal_tv_residuals", problem.temporal_tv_residuals},
+      {"log_temporal_tv_pixels", problem.log_temporal_tv_pixels},
   };
   if (options.objective.shared_structure_tv) {
     json["problem"]["shared_structure_tv"] = {

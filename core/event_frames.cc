@@ -26,4 +26,16 @@ std::vector<uint8_t> EventFrames::FiredPixels() const {
   return fired;
 }
 
+int PolarityReversals(const EventFrames& events, int64_t pixel) {
+  int reversals = 0;
+  float last = 0.0f;
+  for (int k = 0; k < events.num_frames(); ++k) {
+    const float value = events.frame_data(k)[pixel];
+    if (value == 0.0f) continue;
+    if (last != 0.0f && (value > 0.0f) != (last > 0.0f)) ++reversals;
+    last = value;
+  }
+  return reversals;
+}
+
 }  // namespace evfs

@@ -69,6 +69,10 @@ class EventFrames {
   std::vector<int64_t> latent_timestamps_ns_;
 };
 
+/// How many times pixel `pixel`'s events change sign from one event frame that fired to the next
+/// (a flickering light makes many; a moving edge or texture rarely more than two).
+int PolarityReversals(const EventFrames& events, int64_t pixel);
+
 }  // namespace evfs
 
 #endif  // EVFS_CORE_EVENT_FRAMES_H_

@@ -14,6 +14,26 @@
 namespace evfs {
 namespace {
 
+// What the events leave out, as factors of the model's terms. They were chosen on the 17 windows
+// of the shared data with a truth, the real DAVIS windows first, and are not derived
+// (docs/model.md, "A confidence for every output pixel"; BENCHMARKS.md, "Real recordings").
+//  * A change the events drove is uncertain by a share of itself: the events' threshold and the
+//    response's offset are not known exactly. Measured as the estimate's departure from the
+//    observed frame (prediction) or from the frames' blend (between two sharp frames, where the
+//    second frame bounds it), at the pixels that fired.
+constexpr double kPredictionChangeFactor = 0.5;
+constexpr double kBridgeChangeFactor = 0.25;
+//  * Between two sharp frames, a pixel that fired errs by more than the pooled gap of the pair
+//    (one sample of its walk, shared with quiet neighbours) says; a quiet pixel changed by less
+//    than a threshold, smoothly, and the solve follows its own gap most of the way.
+constexpr double kBridgeEventGapFactor = 4.0;
+constexpr double kQuietGapFactor = 0.35;
+//  * Each frame's noise counts once for the truth and once for the observations the estimate
+//    carries; between two frames those are two frames' worth, read from one estimate.
+constexpr double kBridgeNoiseFactor = 1.5;
+//  * The change below one threshold at a pixel that did not fire, next to one that did.
+constexpr double kUnrecordedFactor = 0.5;
+
 // An observed frame where the latent video is pinned: a sharp frame at its latent frame, or a
 // blurred one at the middle of its exposure.
 struct Anchor {
@@ -163,7 +183,8 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
 
   // The gap D between each pair of neighbouring sharp frames, pooled locally.
   const double b = options.log_offset;
-  std::vector<std::vector<float>> pooled_gap(anchors.size());  // [i]: between anchors i, i + 1
+  std::vector<std::vector<float>> own_gap(anchors.size());     // [i]: between anchors i, i + 1
+  std::vector<std::vector<float>> pooled_gap(anchors.size());  // the same, pooled locally
   double sum_gap2 = 0.0, sum_events = 0.0;
   for (size_t i = 0; i + 1 < anchors.size(); ++i) {
     const Anchor& first = anchors[i];
@@ -179,6 +200,7 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
       sum_events += at(n, second.latent, p) - at(n, first.latent, p) + 1.0;
     }
     pooled_gap[i] = BoxMean(gap2, rows, cols, options.pool_radius_px);
+    own_gap[i] = std::move(gap2);
   }
   const double measured = sum_events > 0.0 ? sum_gap2 / sum_events : -1.0;
   const double per_event = measured >= 0.0 ? measured : options.prior_event_variance;
@@ -202,6 +224,14 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
     const bool bridge = before >= 0 && after == before + 1 && !pooled_gap[before].empty();
     double* out = sigma.frame_data(t);
     const double* estimate = latent.frame_data(t);
+    // Between two sharp frames: the time fraction of t, for the frames' blend.
+    double time_fraction = 0.0;
+    if (bridge) {
+      const double start = static_cast<double>(latent.timestamp_ns(anchors[before].latent));
+      const double span = static_cast<double>(latent.timestamp_ns(anchors[after].latent)) - start;
+      time_fraction =
+          span > 0.0 ? (static_cast<double>(latent.timestamp_ns(t)) - start) / span : 0.0;
+    }
     for (size_t p = 0; p < pixels; ++p) {
       double variance = 0.0;
       if (bridge) {
@@ -209,14 +239,25 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
         const double events = at(n, z, p) - at(n, a, p);
         const double s = events > 0.0 ? (at(n, t, p) - at(n, a, p)) / events
                                       : static_cast<double>(t - a) / (z - a);
-        variance = pooled_gap[before][p] * s * (1.0 - s) +
-                   noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
+        const double frames_noise =
+            kBridgeNoiseFactor * noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
+        if (events > 0.0) {
+          const double blend = (1.0 - time_fraction) * anchors[before].image->data()[p] +
+                               time_fraction * anchors[after].image->data()[p];
+          const double change = estimate[p] - blend;
+          variance = kBridgeEventGapFactor * pooled_gap[before][p] * s * (1.0 - s) +
+                     kBridgeChangeFactor * change * change + frames_noise;
+        } else {
+          variance = kQuietGapFactor * own_gap[before][p] * s * (1.0 - s) + frames_noise;
+        }
       } else {
-        const int nearest = before < 0  ? anchors[after].latent
-                            : after < 0 ? anchors[before].latent
-                                        : (t - anchors[before].latent <= anchors[after].latent - t
-                                               ? anchors[before].latent
-                                               : anchors[after].latent);
+        const Anchor& observed =
+            before < 0 ? anchors[after]
+            : after < 0
+                ? anchors[before]
+                : (t - anchors[before].latent <= anchors[after].latent - t ? anchors[before]
+                                                                           : anchors[after]);
+        const int nearest = observed.latent;
         const double events = std::abs(at(n, t, p) - at(n, nearest, p));
         const double one_event = (std::max(estimate[p], 0.0) + b) * options.threshold_spread;
         const double v = per_event >= 0.0 ? per_event : one_event * one_event;
@@ -224,9 +265,12 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
         // the change since the pixel's last crossing, under one threshold and taken as uniform
         // over it (variance C² / 12 in g).
         const double threshold = (std::max(estimate[p], 0.0) + b) * on;
-        const double residual =
-            t != nearest && moved[p] > 0.0f ? threshold * threshold / 12.0 : 0.0;
-        variance = v * events + residual + 2.0 * noise * noise;
+        const double residual = t != nearest && moved[p] > 0.0f
+                                    ? kUnrecordedFactor * threshold * threshold / 12.0
+                                    : 0.0;
+        const double change = events > 0.0 ? estimate[p] - observed.image->data()[p] : 0.0;
+        variance =
+            v * events + residual + kPredictionChangeFactor * change * change + 2.0 * noise * noise;
       }
       out[p] = std::sqrt(variance);
     }

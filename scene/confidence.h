@@ -6,12 +6,15 @@
 //    predict F_b; the gap D = F_b − ((F_a + b) · exp(ΔG) − b), with ΔG the change of g the
 //    events record, is what the events got wrong over the whole interval. Read as a random walk
 //    pinned at both frames (a Brownian bridge), the error at the fraction s of the pixel's
-//    events (or of the time, where it has none) has variance V · s · (1 − s), V the local mean of
-//    D² (pooled over a small neighbourhood, since one pixel's gap is a single sample).
+//    events (or of the time, where it has none) has variance ∝ s · (1 − s): at a pixel that
+//    fired, from the local mean of D² (pooled over a small neighbourhood, since one pixel's gap
+//    is a single sample), plus a share of the change the events drove; at a pixel that did not,
+//    from its own D, a change under one threshold that the solve follows most of the way.
 //  * Beyond the last sharp frame (prediction) or inside a blurred exposure nothing pins the far
 //    end: the variance grows with the events since the nearest observation, n · v, v the
 //    per-event variance the scene's pairs of sharp frames measured (Σ D² / Σ (n + 1)), or the
-//    caller's prior, or the threshold's spread ((I + b) · σ_C)² when nothing measured it.
+//    caller's prior, or the threshold's spread ((I + b) · σ_C)² when nothing measured it; at a
+//    pixel that fired, plus a share of the change the events drove since the observation.
 //  * The frames' own noise, measured where the scene holds still between two sharp frames, else
 //    NoiseSigma's single-frame estimate: once for the frame the output is compared with and
 //    once for the observations the output carries (their blend at s).

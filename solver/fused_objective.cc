@@ -6,6 +6,7 @@
 
 #include "evfs/core/error.h"
 #include "evfs/core/option_checker.h"
+#include "evfs/cost_functions/difference_residual.h"
 #include "evfs/cost_functions/weighted_l1_loss.h"
 #include "evfs/scene/event_model.h"
 #include "evfs/solver/objective_terms.h"
@@ -178,6 +179,9 @@ struct FusedObjective::Impl {
                   Scratch* scratch) const;
   template <L1Penalty kPenalty, EventModel kModel>
   void TimeSeriesTerms(int y, int begin, int end, const double* latent, Scratch* scratch) const;
+  template <typename P>
+  void TemporalTermsInG(int64_t row_start, int begin, int end, const double* latent,
+                        Scratch* scratch) const;
 
   FusedObjectiveOptions options;
   int height = 0, width = 0, num_latent = 0;
@@ -186,6 +190,9 @@ struct FusedObjective::Impl {
   double frame_weight = 0.0, event_weight = 0.0, spatial_weight = 0.0, temporal_weight = 0.0;
   double eps = 0.0;
   EventModelParams event_model;
+  // 1 where the pixel's temporal TV is measured in g (ObjectiveOptions::
+  // log_temporal_tv_reversals); empty where none is.
+  std::vector<uint8_t> temporal_in_g;
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
   std::vector<FrameTerm> frame_terms;
   std::vector<EventTerm> event_terms;
@@ -235,6 +242,16 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
   event_weight = terms.weight(TermFamily::kEvent);
   spatial_weight = terms.weight(TermFamily::kSpatialTv);
   temporal_weight = terms.weight(TermFamily::kTemporalTv);
+  if (temporal_weight > 0.0 && event_model.model == EventModel::kLog &&
+      objective.log_temporal_tv_reversals > 0) {
+    std::vector<uint8_t> flags(static_cast<size_t>(pixels), 0);
+    bool any = false;
+    for (int64_t p = 0; p < pixels; ++p) {
+      flags[p] = PolarityReversals(scene.events, p) >= objective.log_temporal_tv_reversals;
+      any = any || flags[p];
+    }
+    if (any) temporal_in_g = std::move(flags);
+  }
 
   if (frame_weight > 0.0) {
     for (const FrameObservation& frame : scene.frames) {
@@ -527,18 +544,51 @@ void FusedObjective::Impl::TimeSeriesTerms(int y, int begin, int end, const doub
   }
 
   if (temporal_weight > 0.0) {
-    // r = H_{t+1} − H_t  (DifferenceResidual)
+    // r = H_{t+1} − H_t  (DifferenceResidual), except where it is measured in g.
+    const uint8_t* in_g = kModel == EventModel::kLog && !temporal_in_g.empty()
+                              ? temporal_in_g.data() + row_start
+                              : nullptr;
     for (int t = 0; t + 1 < num_latent; ++t) {
       const double* before = intensity(t);
       const double* after = intensity(t + 1);
       double* __restrict g_before = gradient(t);
       double* __restrict g_after = gradient(t + 1);
       for (int x = begin; x < end; ++x) {
+        if (in_g != nullptr && in_g[x]) continue;
         double slope;
         cost[x] += temporal_weight * P::Scalar(after[x] - before[x], eps, &slope);
         g_before[x] -= temporal_weight * slope;
         g_after[x] += temporal_weight * slope;
       }
+    }
+    if (in_g != nullptr) TemporalTermsInG<P>(row_start, begin, end, latent, scratch);
+  }
+}
+
+// The temporal terms of the run's pixels measured in g (TransformedDifferenceResidual),
+// (0.5 + b)·|Δg| where TimeSeriesTerms leaves |ΔH| out.
+template <typename P>
+void FusedObjective::Impl::TemporalTermsInG(int64_t row_start, int begin, int end,
+                                            const double* latent, Scratch* scratch) const {
+  const double scale = TransformedDifferenceResidual::MidGreyScale(event_model);
+  const double offset = event_model.log_offset;
+  const auto g = [offset](double h, double* slope) {
+    *slope = h >= 0.0 ? 1.0 / (h + offset) : 0.0;  // IntensityTransform's derivative
+    return std::log((h >= 0.0 ? h : 0.0) + offset);
+  };
+  double* __restrict cost = scratch->cost.data();
+  for (int x = begin; x < end; ++x) {
+    if (!temporal_in_g[row_start + x]) continue;
+    for (int t = 0; t + 1 < num_latent; ++t) {
+      const double before = latent[t * pixels + row_start + x];
+      const double after = latent[(t + 1) * pixels + row_start + x];
+      double* g_before = scratch->gradient.data() + t * width + x;
+      double* g_after = scratch->gradient.data() + (t + 1) * width + x;
+      double slope, slope_before, slope_after;
+      const double r = scale * (g(after, &slope_after) - g(before, &slope_before));
+      cost[x] += temporal_weight * P::Scalar(r, eps, &slope);
+      *g_before -= temporal_weight * slope * scale * slope_before;
+      *g_after += temporal_weight * slope * scale * slope_after;
     }
   }
 }

@@ -84,6 +84,7 @@ ProblemStatistics& ProblemStatistics::operator+=(const ProblemStatistics& part) 
   event_residuals += part.event_residuals;
   spatial_tv_residuals += part.spatial_tv_residuals;
   temporal_tv_residuals += part.temporal_tv_residuals;
+  log_temporal_tv_pixels += part.log_temporal_tv_pixels;
   prior_residuals += part.prior_residuals;
   distinct_cost_functions += part.distinct_cost_functions;
   active_pixels += part.active_pixels;
@@ -439,10 +440,20 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
   if (terms.has(TermFamily::kTemporalTv)) {
     // Σ_t |H_{t+1}(p) - H_t(p)| is the sum over the pixel's segment boundaries.
     ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kTemporalTv), 1);
-    ceres::CostFunction* difference =
+    ceres::CostFunction* linear =
         cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
+    // A pixel that flickers is measured in g (ObjectiveOptions::log_temporal_tv_reversals).
+    const int min_reversals = objective.log_temporal_tv_reversals;
+    const bool transformed = min_reversals > 0 && objective.event_model.model == EventModel::kLog;
     for (const int64_t p : pixels) {
       if (!inside(p)) continue;
+      ceres::CostFunction* difference = linear;
+      if (transformed && PolarityReversals(scene_.events, p) >= min_reversals) {
+        difference = cache.Get(Family::kTemporalTv, 1.0, {}, [&] {
+          return TransformedDifferenceResidual::Create(objective.event_model);
+        });
+        ++statistics.log_temporal_tv_pixels;
+      }
       for_each_segment(p, [&](int64_t s) {
         if (layout.segment(s).constant || s + 1 >= layout.num_segments() ||
             layout.segment(s + 1).pixel != p) {

@@ -28,7 +28,8 @@ struct ProblemStatistics {
   int64_t event_residuals = 0;
   int64_t spatial_tv_residuals = 0;
   int64_t temporal_tv_residuals = 0;
-  int64_t prior_residuals = 0;  // the quadratic prior (plug & play), one per unknown
+  int64_t log_temporal_tv_pixels = 0;  // pixels whose temporal TV is measured in g (flicker)
+  int64_t prior_residuals = 0;         // the quadratic prior (plug & play), one per unknown
   int64_t distinct_cost_functions = 0;
   int64_t active_pixels = 0;    // pixels whose time series is solved for
   int64_t skipped_pixels = 0;   // pixels left at their initial value (ActivityMask)

@@ -43,6 +43,7 @@ bool ObjectiveOptions::IsValid(std::string* error) const {
       .Check(event_model.model != EventModel::kLog ||
                  (std::isfinite(event_model.log_offset) && event_model.log_offset > 0.0),
              "log_offset (b of log(x + b)) must be positive")
+      .NonNegative("log_temporal_tv_reversals", log_temporal_tv_reversals)
       .Check(IsNonNegativeFinite(prior_weight), "prior_weight must be finite and non-negative")
       .Check(prior_weight == 0.0 || prior_target != nullptr,
              "a positive prior_weight needs a prior_target");

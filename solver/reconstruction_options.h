@@ -42,6 +42,17 @@ struct ObjectiveOptions {
   double spatial_tv_weight = 2.0;
   /// λ_t: weight of temporal total variation (paper Eq. 5), per latent step.
   double temporal_tv_weight = 0.85;
+  /// Pixels whose events reverse polarity at least this many times in the window (a mains lamp,
+  /// a blinking LED: ON and OFF events by turns) get their temporal TV measured in g, the event
+  /// model's domain (TransformedDifferenceResidual), instead of |ΔH|. With the log model |ΔH|
+  /// charges each brightening step more than the darkening step that undoes it, so such a pixel
+  /// drifts dark a little every cycle: predicting 33 ms under a 100 Hz lamp it ended black
+  /// (BENCHMARKS.md, "Flickering light"). A reversal is a change of sign between two event
+  /// frames that fired, so a moving edge or texture rarely makes three: the real windows of the
+  /// shared data have a handful of such pixels, and their figures barely move. 0: every
+  /// pixel's temporal TV is |ΔH|. The Ceres problem and the fused objective build it alike; the
+  /// linear model is unaffected.
+  int log_temporal_tv_reversals = 3;
   /// g and α of the event model: by default the log model g(x) = log(x + 0.5), which matches
   /// the log-intensity events of a sensor, with α derived from the data (α <= 0,
   /// EstimateEventModel); b = 0.5 keeps DAVIS frames, whose response is nearly linear, well

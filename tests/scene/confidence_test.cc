@@ -44,9 +44,20 @@ Video Constant(const Scene& scene, double level) {
   return video;
 }
 
+// The frames' blend on the scene's timeline, plus `offset` everywhere.
+Video Blend(const Scene& scene, double first, double second, double offset = 0.0) {
+  Video video = Constant(scene, 0.0);
+  for (int t = 0; t < video.num_frames(); ++t) {
+    const double w = static_cast<double>(video.timestamp_ns(t)) / kWindowNs;
+    video.frame(t).setConstant((1.0 - w) * first + w * second + offset);
+  }
+  return video;
+}
+
 // Where the events predict the second frame exactly, nothing is uncertain; where they miss it by
-// D, the error between the two events (half of them behind, half ahead) is |D| / 2, and zero at
-// the frames (noise-free flat frames).
+// D, the error of a pixel that fired, between its two events (half of them behind, half ahead),
+// is |D| (4 · D² · s(1 − s) at s = 1/2), and zero at the frames (noise-free flat frames). An
+// estimate that departs from the frames' blend by δ adds (δ / 2)².
 TEST(Confidence, BridgeBetweenSharpFramesGrowsWithTheFramesGap) {
   ConfidenceOptions options;  // Δg 0.2, b 0.5
   const double agreeing = (0.3 + 0.5) * std::exp(2 * 0.2) - 0.5;
@@ -54,22 +65,55 @@ TEST(Confidence, BridgeBetweenSharpFramesGrowsWithTheFramesGap) {
     const Scene scene = MakeInterpolationScene(Flat(0.3, 0), Flat(second, kWindowNs),
                                                TwoOnEventsEverywhere(), BinningOptions());
     ConfidenceModel model;
-    const Video sigma = PredictErrorSigma(scene, Constant(scene, 0.4), options, &model);
+    const Video sigma = PredictErrorSigma(scene, Blend(scene, 0.3, second), options, &model);
     ASSERT_EQ(sigma.num_frames(), scene.num_latent_frames());
     const double gap = std::abs(second - agreeing);
     EXPECT_NEAR(model.measured_event_variance, gap * gap * 64 / (64 * 3), kTolerance);
     EXPECT_EQ(model.frame_noise_sigma, 0.0);
     const int middle = sigma.NearestFrame(kWindowNs / 2);
-    EXPECT_NEAR(sigma.at(middle, 4, 4), gap / 2, kTolerance) << second;
+    EXPECT_NEAR(sigma.at(middle, 4, 4), gap, kTolerance) << second;
     EXPECT_NEAR(sigma.at(0, 4, 4), 0.0, kTolerance);
     EXPECT_NEAR(sigma.at(sigma.num_frames() - 1, 4, 4), 0.0, kTolerance);
+    const double departure = 0.1;
+    EXPECT_NEAR(
+        PredictErrorSigma(scene, Blend(scene, 0.3, second, departure), options).at(middle, 4, 4),
+        std::sqrt(gap * gap + departure * departure / 4), kTolerance);
   }
+}
+
+// A pixel that fired no event between two sharp frames changed by less than a threshold; the
+// solve follows that change, and what is left is a share of its own gap: 0.35 · D² · s(1 − s),
+// s the time fraction.
+TEST(Confidence, AQuietPixelBetweenSharpFramesFollowsItsOwnGap) {
+  const double agreeing = (0.3 + 0.5) * std::exp(2 * 0.2) - 0.5;
+  const EventStream everywhere = TwoOnEventsEverywhere();
+  EventStream events(kSize, kSize);
+  for (size_t i = 0; i < everywhere.size(); ++i) {
+    if (everywhere.x(i) == 4 && everywhere.y(i) == 4) continue;
+    events.push_back(everywhere.t_ns(i), everywhere.x(i), everywhere.y(i), everywhere.polarity(i));
+  }
+  TimedFrame second = Flat(agreeing, kWindowNs);
+  const double quiet_gap = 0.05;
+  second.image(4, 4) = 0.3 + quiet_gap;
+  const Scene scene = MakeInterpolationScene(Flat(0.3, 0), second, events, BinningOptions());
+  ConfidenceModel model;
+  const Video sigma =
+      PredictErrorSigma(scene, Blend(scene, 0.3, agreeing), ConfidenceOptions(), &model);
+  const int middle = sigma.NearestFrame(kWindowNs / 2);
+  const double s = static_cast<double>(sigma.timestamp_ns(middle)) / kWindowNs;
+  // The frames' noise (the one bright pixel reads as some) counts 1.5 times per frame carried.
+  const double noise = model.frame_noise_sigma;
+  const double frames_noise = 1.5 * noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
+  EXPECT_NEAR(sigma.at(middle, 4, 4),
+              std::sqrt(0.35 * quiet_gap * quiet_gap * s * (1.0 - s) + frames_noise), kTolerance);
+  // The noise read is small beside the gap, so the gap's share is what the band shows.
+  EXPECT_LT(noise, quiet_gap / 2);
 }
 
 // After a single frame nothing measures the events: each one may be wrong by the threshold's
 // spread, ((I + b) · σ_C), and the errors add as a random walk; a prior per-event variance
 // replaces it. Away from the frame, where the scene moved, the change not yet recorded adds
-// ((I + b) · Δg)² / 12.
+// half of ((I + b) · Δg)² / 12, and an estimate that departs from the frame by δ adds δ² / 2.
 TEST(Confidence, PredictionGrowsWithTheEventsSinceTheFrame) {
   const Scene scene =
       MakePredictionScene(Flat(0.3, 0), kWindowNs, TwoOnEventsEverywhere(), BinningOptions());
@@ -78,13 +122,21 @@ TEST(Confidence, PredictionGrowsWithTheEventsSinceTheFrame) {
   const Video sigma = PredictErrorSigma(scene, Constant(scene, 0.3), options, &model);
   EXPECT_LT(model.measured_event_variance, 0.0);
   const int last = sigma.num_frames() - 1;
-  const double unrecorded = 0.8 * 0.2 * 0.8 * 0.2 / 12.0;
+  const double unrecorded = 0.5 * 0.8 * 0.2 * 0.8 * 0.2 / 12.0;
   EXPECT_NEAR(sigma.at(0, 2, 2), 0.0, kTolerance);
   EXPECT_NEAR(sigma.at(last, 2, 2), std::sqrt(2.0 * 0.8 * 0.03 * 0.8 * 0.03 + unrecorded),
               kTolerance);
   options.prior_event_variance = 0.01;
   EXPECT_NEAR(PredictErrorSigma(scene, Constant(scene, 0.3), options).at(last, 2, 2),
               std::sqrt(2 * 0.01 + unrecorded), kTolerance);
+  // The estimate at the frame is the frame; after it, 0.1 above.
+  Video departed = Constant(scene, 0.4);
+  departed.frame(0).setConstant(0.3);
+  const Video wider = PredictErrorSigma(scene, departed, options);
+  const double unrecorded_at_04 = 0.5 * 0.9 * 0.2 * 0.9 * 0.2 / 12.0;
+  EXPECT_NEAR(wider.at(last, 2, 2), std::sqrt(2 * 0.01 + unrecorded_at_04 + 0.1 * 0.1 / 2),
+              kTolerance);
+  EXPECT_NEAR(wider.at(0, 2, 2), 0.0, kTolerance);
 }
 
 // Where no pixel of a 3x3 neighbourhood fired between two sharp frames, their difference is

@@ -439,6 +439,43 @@ TEST(Reconstructor, EventSaturationFollowsHowTheChangePerEventIsKnown) {
   EXPECT_THROW(Reconstruct(interpolation, options), InvalidArgumentError);
 }
 
+// A prediction under a flickering light: one frame (0.7 everywhere) and then, on every pixel,
+// ON and OFF events by turns, 12 cycles that end where they began. With |ΔH| as its temporal
+// TV a pixel drifts dark a little each cycle (a brightening step costs more than the darkening
+// one); measured in g, it ends near the frame.
+TEST(Reconstructor, AFlickeringPixelDoesNotDriftDark) {
+  constexpr int kRows = 6, kCols = 6, kCycles = 12, kSteps = 2 * kCycles;
+  Scene scene;
+  scene.height = kRows;
+  scene.width = kCols;
+  scene.events = EventFrames(kRows, kCols);
+  std::vector<int64_t> times;
+  for (int k = 0; k <= kSteps; ++k) times.push_back(1000000LL * k);
+  for (int k = 0; k < kSteps; ++k) {
+    scene.events.AddFrame({k, k + 1, times[k], times[k + 1], 1});
+    for (int y = 0; y < kRows; ++y) {
+      for (int x = 0; x < kCols; ++x) scene.events.value(k, y, x) = k % 2 == 0 ? 1.0f : -1.0f;
+    }
+  }
+  scene.events.set_latent_timestamps_ns(times);
+  scene.num_events = static_cast<int64_t>(kSteps) * kRows * kCols;
+  constexpr double kFrame = 0.7;
+  scene.frames.push_back({Image::Constant(kRows, kCols, kFrame), 0, 0, "first"});
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  const auto end_value = [&](int min_reversals) {
+    options.objective.log_temporal_tv_reversals = min_reversals;
+    const Reconstruction result = Reconstruct(scene, options);
+    EXPECT_TRUE(result.summary.solved);
+    EXPECT_EQ(result.summary.problem.log_temporal_tv_pixels, min_reversals > 0 ? kRows * kCols : 0);
+    return result.video.frame(kSteps)(3, 3);
+  };
+  const double in_g = end_value(ObjectiveOptions().log_temporal_tv_reversals);
+  const double linear = end_value(0);
+  EXPECT_NEAR(in_g, kFrame, 0.05);
+  EXPECT_LT(linear, kFrame - 0.15);
+}
+
 TEST(Reconstructor, QuietPixelsTakeTheBlendOfTheFrames) {
   Scene scene = MakeSceneWithEvents(6, 8, {{0, 2, 2}, {1, 2, 3}, {2, 3, 3}});
   scene.frames[0].image = Image::Constant(6, 8, 0.40);
