@@ -19,13 +19,7 @@ parse_arguments "$0" "$@"
 echo "| clip | variant | window | in g (default) | on H | copy / blend | pixels in g |"
 echo "|---|---|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
-  frames="$out/frames_$clip"
-  [ -f "$frames/images.txt" ] || python3 "$helper" crop "$data/$clip" "$frames" "$crop" 17
-  # The LED (in "all") a quarter of the way into the frame, as realistic_variants.sh puts it.
-  read -r width height < <(python3 -c "
-import sys; sys.path.insert(0, '$(dirname "$helper")'); import realistic_variants_helper as h
-rows = h.read_png('$frames/frames/frame_00000000.png'); print(len(rows[0]), len(rows))")
-  led_x=$((width / 4)); led_y=$((height / 4)); led_r=$((width / 20 > 3 ? width / 20 : 3))
+  prepare_clip "$clip"
   for variant in mains all; do
     sim="$out/sim_${clip}_$variant"
     # shellcheck disable=SC2046  # the flags are words

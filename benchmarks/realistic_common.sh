@@ -1,6 +1,7 @@
 # Sourced by benchmarks/realistic_variants.sh and realistic_video.sh.
 #
 #   parse_arguments SCRIPT BUILD_DIR DATA_DIR OUT_DIR [CROP_PX] [CLIP...]
+#   prepare_clip CLIP [FRAMES]
 #   variant_flags LED_X LED_Y LED_RADIUS VARIANT
 
 # Sets build, data, out (created), crop, clips (clips.txt's when none given), evfs and helper.
@@ -24,6 +25,21 @@ parse_arguments() {
   mkdir -p "$out"
   out=$(cd "$out" && pwd)
   helper="$here/realistic_variants_helper.py"
+}
+
+# Crops the first FRAMES (17 by default) frames of CLIP to crop x crop pixels into
+# $out/frames_CLIP, once, and sets frames (that folder) and the LED's place in it: a quarter of
+# the way into the frame (led_x, led_y), radius a twentieth of its width and at least 3 (led_r).
+prepare_clip() {
+  frames="$out/frames_$1"
+  [ -f "$frames/images.txt" ] || python3 "$helper" crop "$data/$1" "$frames" "$crop" "${2:-17}"
+  local width height
+  read -r width height < <(python3 -c "
+import sys; sys.path.insert(0, '$(dirname "$helper")'); import realistic_variants_helper as h
+rows = h.read_png('$frames/frames/frame_00000000.png'); print(len(rows[0]), len(rows))")
+  led_x=$((width / 4))
+  led_y=$((height / 4))
+  led_r=$((width / 20 > 3 ? width / 20 : 3))
 }
 
 # The variants: name, then the simulate flags. The LED sits a quarter of the way into the frame

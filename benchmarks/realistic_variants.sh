@@ -29,12 +29,7 @@ methods=("default:" "blend:--solver=blend" "integrate:--solver=integrate")
 echo "| clip | variant | method | PSNR (summary.json) | SSIM (summary.json) | PSNR vs clean frame | PSNR away from the LED |"
 echo "|---|---|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
-  frames="$out/frames_$clip"
-  [ -f "$frames/images.txt" ] || python3 "$helper" crop "$data/$clip" "$frames" "$crop" 17
-  read -r width height < <(python3 -c "
-import sys; sys.path.insert(0, '$(dirname "$helper")'); import realistic_variants_helper as h
-rows = h.read_png('$frames/frames/frame_00000000.png'); print(len(rows[0]), len(rows))")
-  led_x=$(( width / 4 )); led_y=$(( height / 4 )); led_r=$(( width / 20 > 3 ? width / 20 : 3 ))
+  prepare_clip "$clip"
   for variant in "${variants[@]}"; do
     sim="$out/sim_${clip}_$variant"
     # shellcheck disable=SC2046  # the flags are words

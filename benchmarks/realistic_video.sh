@@ -28,14 +28,7 @@ parse_arguments "$0" "$@"
 echo "| clip | variant | withheld | video PSNR / SSIM | blend | one by one, instant | one by one, over the exposure | exposures found blurred |"
 echo "|---|---|---|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
-  frames="$out/frames_$clip"
-  count=$(grep -cv '^#' "$data/$clip/images.txt")
-  [ -f "$frames/images.txt" ] || python3 "$helper" crop "$data/$clip" "$frames" "$crop" "$count"
-  side=$(( crop > 0 ? crop : 0 ))
-  [ "$side" -gt 0 ] || side=$(python3 -c "
-import sys; sys.path.insert(0, '$(dirname "$helper")'); import realistic_variants_helper as h
-print(len(h.read_png('$frames/frames/frame_00000000.png')[0]))")
-  led_x=$(( side / 4 )); led_y=$(( side / 4 )); led_r=$(( side / 20 > 3 ? side / 20 : 3 ))
+  prepare_clip "$clip" "$(grep -cv '^#' "$data/$clip/images.txt")"
   for variant in exposure20ms all; do
     sim="$out/sim_${clip}_$variant"
     # shellcheck disable=SC2046  # the flags are words
