@@ -31,7 +31,8 @@ constexpr double kQuietGapFactor = 0.35;
 //  * Each frame's noise counts once for the truth and once for the observations the estimate
 //    carries; between two frames those are two frames' worth, read from one estimate.
 constexpr double kBridgeNoiseFactor = 1.5;
-//  * The change below one threshold at a pixel that did not fire, next to one that did.
+//  * Where the scene moved, the change since a pixel's last crossing, under one threshold: half
+//    of what a change uniform over the threshold would leave (C² / 12 in g).
 constexpr double kUnrecordedFactor = 0.5;
 
 // An observed frame where the latent video is pinned: a sharp frame at its latent frame, or a
