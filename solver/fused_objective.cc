@@ -190,8 +190,7 @@ struct FusedObjective::Impl {
   double frame_weight = 0.0, event_weight = 0.0, spatial_weight = 0.0, temporal_weight = 0.0;
   double eps = 0.0;
   EventModelParams event_model;
-  // 1 where the pixel's temporal TV is measured in g (ObjectiveOptions::
-  // log_temporal_tv_reversals); empty where none is.
+  // ObjectiveTerms::temporal_tv_in_g: 1 where the pixel's temporal TV is measured in g.
   std::vector<uint8_t> temporal_in_g;
   SpatialTv spatial_tv = SpatialTv::kAnisotropic;
   std::vector<FrameTerm> frame_terms;
@@ -242,16 +241,7 @@ FusedObjective::Impl::Impl(const Scene& scene, const ObjectiveOptions& objective
   event_weight = terms.weight(TermFamily::kEvent);
   spatial_weight = terms.weight(TermFamily::kSpatialTv);
   temporal_weight = terms.weight(TermFamily::kTemporalTv);
-  if (temporal_weight > 0.0 && event_model.model == EventModel::kLog &&
-      objective.log_temporal_tv_reversals > 0) {
-    std::vector<uint8_t> flags(static_cast<size_t>(pixels), 0);
-    bool any = false;
-    for (int64_t p = 0; p < pixels; ++p) {
-      flags[p] = PolarityReversals(scene.events, p) >= objective.log_temporal_tv_reversals;
-      any = any || flags[p];
-    }
-    if (any) temporal_in_g = std::move(flags);
-  }
+  temporal_in_g = terms.temporal_tv_in_g();
 
   if (frame_weight > 0.0) {
     for (const FrameObservation& frame : scene.frames) {
@@ -571,11 +561,6 @@ template <typename P>
 void FusedObjective::Impl::TemporalTermsInG(int64_t row_start, int begin, int end,
                                             const double* latent, Scratch* scratch) const {
   const double scale = TransformedDifferenceResidual::MidGreyScale(event_model);
-  const double offset = event_model.log_offset;
-  const auto g = [offset](double h, double* slope) {
-    *slope = h >= 0.0 ? 1.0 / (h + offset) : 0.0;  // IntensityTransform's derivative
-    return std::log((h >= 0.0 ? h : 0.0) + offset);
-  };
   double* __restrict cost = scratch->cost.data();
   for (int x = begin; x < end; ++x) {
     if (!temporal_in_g[row_start + x]) continue;
@@ -584,11 +569,13 @@ void FusedObjective::Impl::TemporalTermsInG(int64_t row_start, int begin, int en
       const double after = latent[(t + 1) * pixels + row_start + x];
       double* g_before = scratch->gradient.data() + t * width + x;
       double* g_after = scratch->gradient.data() + (t + 1) * width + x;
-      double slope, slope_before, slope_after;
-      const double r = scale * (g(after, &slope_after) - g(before, &slope_before));
+      const double r = scale * (IntensityTransform(after, event_model) -
+                                IntensityTransform(before, event_model));
+      double slope;
       cost[x] += temporal_weight * P::Scalar(r, eps, &slope);
-      *g_before -= temporal_weight * slope * scale * slope_before;
-      *g_after += temporal_weight * slope * scale * slope_after;
+      const double coefficient = temporal_weight * slope * scale;
+      *g_before -= coefficient * IntensityTransformDerivative(before, event_model);
+      *g_after += coefficient * IntensityTransformDerivative(after, event_model);
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "evfs/core/error.h"
 
@@ -58,6 +59,16 @@ ObjectiveTerms::ObjectiveTerms(const Scene& scene, const ObjectiveOptions& objec
   }
   if (has(TermFamily::kTemporalTv)) {
     counts_[static_cast<int>(TermFamily::kTemporalTv)] = (num_latent - 1) * active;
+    const int min_reversals = objective.log_temporal_tv_reversals;
+    if (min_reversals > 0 && objective.event_model.model == EventModel::kLog) {
+      std::vector<uint8_t> in_g(static_cast<size_t>(pixels), 0);
+      bool any = false;
+      for (int64_t p = 0; p < pixels; ++p) {
+        in_g[p] = PolarityReversals(scene.events, p) >= min_reversals;
+        any = any || in_g[p];
+      }
+      if (any) temporal_tv_in_g_ = std::move(in_g);
+    }
   }
   if (has(TermFamily::kPrior)) {
     counts_[static_cast<int>(TermFamily::kPrior)] = static_cast<int64_t>(num_latent) * active;

@@ -14,6 +14,9 @@
 // * A spatial TV term exists when any pixel it touches is active; it belongs to its top-left
 //   pixel. Anisotropic TV is two terms per pixel, (p, right) and (p, below); the paper and
 //   isotropic forms one three-point term (p, right, below).
+// * A pixel whose events reverse sign at least log_temporal_tv_reversals times (log model) has
+//   its temporal terms measured in g, (0.5 + b)·(g(H_{t+1}) − g(H_t))
+//   (TransformedDifferenceResidual), not H.
 // * The prior is the one quadratic family: ADMM's coupling term ρ/2‖H − T‖² towards a target
 //   video T (plug & play, paper §3.4), over the active voxels. Only the Ceres problem builds
 //   it; the fused objective rejects it.
@@ -91,6 +94,14 @@ class ObjectiveTerms {
     return {tv_offset_right_[p], tv_offset_below_[p]};
   }
 
+  /// Per pixel, 1 where its temporal terms are measured in g (ObjectiveOptions::
+  /// log_temporal_tv_reversals: the log model, temporal terms, and at least that many
+  /// PolarityReversals); empty when no pixel's are.
+  const std::vector<uint8_t>& temporal_tv_in_g() const { return temporal_tv_in_g_; }
+  bool temporal_tv_in_g_at(int64_t p) const {
+    return !temporal_tv_in_g_.empty() && temporal_tv_in_g_[p] != 0;
+  }
+
  private:
   void ComputeSharedStructureOffsets(const Scene& scene);
 
@@ -100,6 +111,7 @@ class ObjectiveTerms {
   std::array<double, kNumTermFamilies> weights_{};
   std::array<int64_t, kNumTermFamilies> counts_{};
   std::vector<double> tv_offset_right_, tv_offset_below_;  // per pixel; empty: plain TV
+  std::vector<uint8_t> temporal_tv_in_g_;                  // per pixel; empty: none
   double shared_structure_correlation_ = 0.0;
 };
 

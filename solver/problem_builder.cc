@@ -442,13 +442,10 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
     ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kTemporalTv), 1);
     ceres::CostFunction* linear =
         cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
-    // A pixel that flickers is measured in g (ObjectiveOptions::log_temporal_tv_reversals).
-    const int min_reversals = objective.log_temporal_tv_reversals;
-    const bool transformed = min_reversals > 0 && objective.event_model.model == EventModel::kLog;
     for (const int64_t p : pixels) {
       if (!inside(p)) continue;
       ceres::CostFunction* difference = linear;
-      if (transformed && PolarityReversals(scene_.events, p) >= min_reversals) {
+      if (terms.temporal_tv_in_g_at(p)) {
         difference = cache.Get(Family::kTemporalTv, 1.0, {}, [&] {
           return TransformedDifferenceResidual::Create(objective.event_model);
         });
