@@ -134,12 +134,15 @@ std::string PageEnd(const Json& model, const Json& settings) {
   page += "<h2>Event model</h2>\n" +
           (model.empty() ? std::string("<p>not reported by this run</p>\n") : Table(model));
   page += "<h2>Settings</h2>\n" + Table(settings);
-  // A self-check, run only when the page is opened as report.html#selfcheck (the browser test
-  // does): plays the video if there is one, counts the plots and the pictures that did not load
-  // and lists every resource the page loaded.
+  // A self-check, run only when the page is opened as report.html#selfcheck or #selfcheck:MS (the
+  // browser test does): plays the video if there is one, counts the plots and the pictures that
+  // did not load and lists every resource the page loaded. It reports once the video has shown a
+  // frame and its clock has moved, or after MS milliseconds (1500 unless given) if it never does.
   page += R"(<pre id="selfcheck"></pre>
 <script>
-if (location.hash === '#selfcheck') {
+var selfcheck = /^#selfcheck(?::([0-9]+))?$/.exec(location.hash);
+if (selfcheck) {
+  var wait_ms = selfcheck[1] ? Number(selfcheck[1]) : 1500;
   window.addEventListener('load', function () {
     var report = {plots: 0, empty_plots: 0, images: 0, broken_images: 0, video_ready: 0,
                   video_time: 0, resources: []};
@@ -154,7 +157,10 @@ if (location.hash === '#selfcheck') {
       if (!img.complete || img.naturalWidth === 0) report.broken_images++;
     });
     var video = document.getElementById('video');
+    var reported = false;
     var finish = function () {
+      if (reported) return;
+      reported = true;
       report.video_ready = video ? video.readyState : -1;
       report.video_time = video ? video.currentTime : -1;
       report.resources = performance.getEntriesByType('resource').map(function (e) {
@@ -167,8 +173,11 @@ if (location.hash === '#selfcheck') {
     };
     if (!video) { finish(); return; }
     video.muted = true;
+    video.addEventListener('timeupdate', function () {
+      if (video.readyState >= 2 && video.currentTime > 0) finish();
+    });
     video.play().catch(function (e) { report.play_error = String(e); });
-    setTimeout(finish, 1500);
+    setTimeout(finish, wait_ms);
   });
 }
 </script>

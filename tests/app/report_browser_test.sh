@@ -21,16 +21,19 @@ trap 'rm -rf "$work"' EXIT
 # Opens OUT/report.html with its self-check and holds the report to: PLOTS plots, all drawn, at
 # least IMAGES pictures, all loaded, the video playing when VIDEO is 1, nothing outside OUT.
 # Chromium decodes the video in real time while the page's clock is virtual, so on a loaded
-# machine the video may not have started when the page reports: that alone is tried again, up to
-# three times; every other check fails at once.
+# machine the video may not have started when the page gives up waiting: that alone is tried
+# again, up to three times, each time with a longer wait (the page reports as soon as the video
+# plays); every other check fails at once.
 # Usage: check_page OUT PLOTS IMAGES VIDEO
 check_page() {
-  local out=$1 plots=$2 images=$3 video=$4 dom line attempt status
+  local out=$1 plots=$2 images=$3 video=$4 dom line attempt status budget_ms
   for attempt in 1 2 3; do
-    dom=$(timeout 60 "$browser" --headless --disable-gpu --no-sandbox \
+    budget_ms=$((3000 * attempt * attempt))
+    dom=$(timeout 90 "$browser" --headless --disable-gpu --no-sandbox \
       --user-data-dir="$work/profile" --autoplay-policy=no-user-gesture-required \
       --proxy-server=127.0.0.1:9 --host-resolver-rules="MAP * ~NOTFOUND" \
-      --virtual-time-budget=3000 --dump-dom "file://$out/report.html#selfcheck" \
+      --virtual-time-budget=$budget_ms \
+      --dump-dom "file://$out/report.html#selfcheck:$((budget_ms - 1000))" \
       2> "$work/chromium.log" || true)
     line=$(grep -o 'SELFCHECK {[^<]*}' <<< "$dom" || true)
     if [[ -z $line ]]; then
