@@ -59,8 +59,11 @@ std::vector<float> BoxMean(const std::vector<float>& values, int rows, int cols,
 // difference of its two frames is mostly their noise (variance 2σ²). The estimate is the robust
 // one, 1.4826 · median |d − median d| / √2 over every such pixel d = F_b − F_a of every pair.
 // Unlike a single frame's estimate it does not read texture or fixed-pattern noise, which the
-// reconstruction carries from the frames and the truth shares. −1 when the scene has no pair of
-// sharp frames or fewer than kMinStillPixels still pixels.
+// reconstruction carries from the frames and the truth shares. A pixel clipped in either frame
+// (IsClippedLevel) shows no noise and is left out, as from the single-frame estimate: under a
+// saturated region the still pixels would otherwise measure none, and every quiet pixel's band
+// would shrink to nothing. −1 when the scene has no pair of sharp frames or fewer than
+// kMinStillPixels still pixels.
 double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float>& counts,
                      size_t pixels, int rows, int cols) {
   constexpr size_t kMinStillPixels = 500;
@@ -86,7 +89,9 @@ double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float
         }
         if (!still) continue;
         const size_t p = static_cast<size_t>(r) * cols + c;
-        differences.push_back(second.image->data()[p] - first.image->data()[p]);
+        const double a = first.image->data()[p], b = second.image->data()[p];
+        if (IsClippedLevel(a) || IsClippedLevel(b)) continue;
+        differences.push_back(b - a);
       }
     }
   }
@@ -168,7 +173,7 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
   for (const FrameObservation& frame : scene.frames) {
     anchors.push_back({(frame.latent_first + frame.latent_last) / 2, &frame.image,
                        frame.latent_first == frame.latent_last});
-    noise += NoiseSigma(frame.image);
+    noise += NoiseSigma(frame.image, /*leave_out_clipped=*/true);
   }
   if (!anchors.empty()) noise /= static_cast<double>(anchors.size());
   std::stable_sort(anchors.begin(), anchors.end(),

@@ -27,12 +27,23 @@ bool ExposureBlurOptions::IsValid(std::string* error) const {
   return check.Passed(error);
 }
 
-double NoiseSigma(const Image& frame) {
+double NoiseSigma(const Image& frame, bool leave_out_clipped) {
   const int64_t rows = frame.rows(), cols = frame.cols();
   if (rows < 3 || cols < 3) return 0.0;
+  const auto clipped_around = [&frame](int64_t y, int64_t x) {
+    for (int64_t dy = -1; dy <= 1; ++dy) {
+      for (int64_t dx = -1; dx <= 1; ++dx) {
+        if (IsClippedLevel(frame(y + dy, x + dx))) return true;
+      }
+    }
+    return false;
+  };
   double sum = 0.0;
+  int64_t counted = 0;
   for (int64_t y = 1; y + 1 < rows; ++y) {
     for (int64_t x = 1; x + 1 < cols; ++x) {
+      if (leave_out_clipped && clipped_around(y, x)) continue;
+      ++counted;
       const double response = frame(y - 1, x - 1) - 2.0 * frame(y - 1, x) + frame(y - 1, x + 1) -
                               2.0 * frame(y, x - 1) + 4.0 * frame(y, x) - 2.0 * frame(y, x + 1) +
                               frame(y + 1, x - 1) - 2.0 * frame(y + 1, x) + frame(y + 1, x + 1);
@@ -40,7 +51,8 @@ double NoiseSigma(const Image& frame) {
     }
   }
   constexpr double kHalfPi = 1.5707963267948966;
-  return std::sqrt(kHalfPi) * sum / (6.0 * static_cast<double>((rows - 2) * (cols - 2)));
+  if (counted == 0) return 0.0;
+  return std::sqrt(kHalfPi) * sum / (6.0 * static_cast<double>(counted));
 }
 
 ExposureBlurEstimate ExposureBlur(const Image& frame, const EventStream& all_events,

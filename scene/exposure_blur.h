@@ -54,11 +54,19 @@ struct ExposureBlurEstimate {
   std::string description;
 };
 
+/// Whether a frame's intensity (in [0, 1]) is within half an 8-bit level of black or white,
+/// where the sensor clips it: such a pixel shows no noise.
+inline bool IsClippedLevel(double intensity) {
+  return intensity <= 0.5 / 255.0 || intensity >= 1.0 - 0.5 / 255.0;
+}
+
 /// The standard deviation of a frame's noise, estimated from the frame alone (J. Immerkær, "Fast
 /// noise variance estimation", CVIU 1996): the mean absolute response to the Laplacian-difference
 /// mask that cancels locally linear image content, sqrt(π/2) / (6 (W−2)(H−2)) · Σ |I ∗ M|.
-/// Frames smaller than 3×3 give 0.
-double NoiseSigma(const Image& frame);
+/// Frames smaller than 3×3 give 0. With `leave_out_clipped`, the sum runs only over pixels
+/// whose 3×3 neighbourhood has no clipped value (IsClippedLevel): a clipped region shows no
+/// noise, and counted it would dilute the estimate (0 when none is left).
+double NoiseSigma(const Image& frame, bool leave_out_clipped = false);
 
 /// Whether the exposure [begin_ns, end_ns] blurred `frame`, from the events of `events` inside it
 /// (events outside are ignored). Throws InvalidArgumentError for invalid options, an empty

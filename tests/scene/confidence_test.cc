@@ -179,6 +179,48 @@ TEST(Confidence, FrameNoiseIsMeasuredWhereTheSceneHoldsStill) {
       << model.description;
 }
 
+// Under a saturated (or black) region the still pixels' difference is exactly zero: they show no
+// noise and must not hide the noise of the rest. Three quarters of the frame clipped white and
+// an eighth black, the rest noisy: the noise is the rest's.
+TEST(Confidence, ClippedPixelsDoNotHideTheFramesNoise) {
+  constexpr int kWide = 64;
+  const double sigma_noise = 0.01;
+  uint64_t state = 777;
+  const auto uniform = [&state]() {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (static_cast<double>(state >> 11) + 0.5) / 9007199254740992.0;
+  };
+  const auto gaussian = [&uniform]() {
+    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(6.283185307179586 * uniform());
+  };
+  TimedFrame first, second;
+  first.image = Image::Constant(kWide, kWide, 1.0);
+  second.image = Image::Constant(kWide, kWide, 1.0);
+  for (int y = 0; y < kWide; ++y) {
+    for (int x = 0; x < kWide; ++x) {
+      if (y < 8) {
+        first.image(y, x) = second.image(y, x) = 0.0;
+      } else if (y < 16) {
+        first.image(y, x) = 0.5 + sigma_noise * gaussian();
+        second.image(y, x) = 0.5 + sigma_noise * gaussian();
+      }
+    }
+  }
+  first.exposure_begin_ns = first.exposure_end_ns = 0;
+  second.exposure_begin_ns = second.exposure_end_ns = kWindowNs;
+  first.label = second.label = "clipped";
+  EventStream events(kWide, kWide);
+  events.push_back(kWindowNs / 2, 40, 40, 1);
+  const Scene scene = MakeInterpolationScene(first, second, events, BinningOptions());
+  ConfidenceModel model;
+  const Video sigma = PredictErrorSigma(scene, Blend(scene, 0.5, 0.5), ConfidenceOptions(), &model);
+  EXPECT_NEAR(model.frame_noise_sigma, sigma_noise, 0.15 * sigma_noise);
+  EXPECT_NE(model.description.find("measured where the scene holds still"), std::string::npos)
+      << model.description;
+  // A quiet pixel of the white region between the frames: its band is the frames' noise, not 0.
+  EXPECT_GT(sigma.frame(sigma.num_frames() / 2)(30, 10), 0.5 * sigma_noise);
+}
+
 TEST(Confidence, ShareWithinSigmaCountsThePixelsInsideTheBand) {
   const Image truth = Image::Constant(2, 2, 0.5);  // 127.5: not a whole 8-bit level
   Image estimate = truth;

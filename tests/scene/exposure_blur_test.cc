@@ -37,6 +37,19 @@ TEST(ExposureBlur, NoiseSigmaReadsTheNoiseOfASmoothFrame) {
   EXPECT_EQ(NoiseSigma(Image::Constant(2, 5, 0.5)), 0.0);
 }
 
+// Half the frame clipped white: counted, it halves the estimate; left out, the estimate is the
+// noise of the rest. A frame clipped everywhere has nothing left to read.
+TEST(ExposureBlur, NoiseSigmaCanLeaveOutClippedPixels) {
+  const double sigma = 0.02;
+  Image image = NoisyRamp(sigma, 11);
+  image.topRows(kHeight / 2).setConstant(1.0);
+  EXPECT_LT(NoiseSigma(image), 0.6 * sigma);
+  EXPECT_NEAR(NoiseSigma(image, /*leave_out_clipped=*/true), sigma, kNoiseSigmaTolerance * sigma);
+  EXPECT_TRUE(IsClippedLevel(0.0) && IsClippedLevel(1.0) && !IsClippedLevel(1.0 / 255.0) &&
+              !IsClippedLevel(254.0 / 255.0));
+  EXPECT_EQ(NoiseSigma(Image::Constant(8, 8, 0.0), /*leave_out_clipped=*/true), 0.0);
+}
+
 // A still, noisy frame whose events are isolated background activity stays sharp.
 TEST(ExposureBlur, StillFrameWithNoiseEventsIsSharp) {
   const Image frame = NoisyRamp(0.01, 3);
