@@ -12,7 +12,8 @@ folder summary.json names, or in --data (for a recording evfs reads from a file:
 with the share of its level's bin inside the band, as evfs' `within_predicted_sigma` does
 (scene/confidence.h, ShareWithinSigma); at k = 1 the share is that figure. Prints one markdown
 row per folder: the shares, and the k at which the band would hold 68 % (the scale a calibrated
-band needs; "> kmax" when even the largest k holds less).
+band needs; "> kmax" when even the largest k holds less). With --strict a pixel counts when
+|estimate - truth| <= k sigma, whatever the truth's bit depth.
 Needs python3-opencv and python3-numpy.
 """
 
@@ -34,8 +35,8 @@ def read(path):
     return image.astype(np.float64) / scale, image.dtype == np.uint8
 
 
-def shares(estimate, sigma, truth, eight_bit, scales):
-    half = 0.5 / 255.0 if eight_bit else 0.0
+def shares(estimate, sigma, truth, eight_bit, scales, strict=False):
+    half = 0.5 / 255.0 if eight_bit and not strict else 0.0
     result = []
     for k in scales:
         band = k * sigma
@@ -53,6 +54,8 @@ def main():
     parser.add_argument("out_dirs", nargs="+")
     parser.add_argument("--data", default="", help="the recording as a folder (images.txt)")
     parser.add_argument("--scales", default="0.6,0.8,1,1.25,1.5,2")
+    parser.add_argument("--strict", action="store_true",
+                        help="count |estimate - truth| <= k sigma, an 8-bit truth's bin ignored")
     args = parser.parse_args()
     scales = [float(k) for k in args.scales.split(",")]
     fine = np.linspace(0.1, max(scales), 400)
@@ -75,8 +78,8 @@ def main():
         name = "%06d.png" % truth_info["latent_index"]
         estimate, _ = read(os.path.join(out, "frames", name))
         sigma, _ = read(os.path.join(out, "confidence", name))
-        row = shares(estimate, sigma, truth, eight_bit, scales)
-        curve = shares(estimate, sigma, truth, eight_bit, fine)
+        row = shares(estimate, sigma, truth, eight_bit, scales, args.strict)
+        curve = shares(estimate, sigma, truth, eight_bit, fine, args.strict)
         needed = next((k for k, share in zip(fine, curve) if share >= 0.68), None)
         print("| %s | %s | %s |" % (os.path.basename(os.path.normpath(out)),
                                     " | ".join("%.1f %%" % (100 * s) for s in row),
