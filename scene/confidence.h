@@ -15,9 +15,10 @@
 //    per-event variance the scene's pairs of sharp frames measured (Σ D² / Σ (n + 1)), or the
 //    caller's prior, or the threshold's spread ((I + b) · σ_C)² when nothing measured it; at a
 //    pixel that fired, plus a share of the change the events drove since the observation.
-//  * The frames' own noise, measured where the scene holds still between two sharp frames, else
-//    NoiseSigma's single-frame estimate: once for the frame the output is compared with and
-//    once for the observations the output carries (their blend at s).
+//  * The frames' own noise, the smaller of what the difference of two sharp frames shows where
+//    the scene holds still and NoiseSigma's single-frame estimate, both without clipped pixels
+//    (IsClippedLevel): once for the frame the output is compared with and once for the
+//    observations the output carries (their blend at s).
 #ifndef EVFS_SCENE_CONFIDENCE_H_
 #define EVFS_SCENE_CONFIDENCE_H_
 
