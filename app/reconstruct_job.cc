@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "evfs/app/frame_lag.h"
+#include "evfs/app/solver_json.h"
 #include "evfs/core/error.h"
 #include "evfs/core/metrics.h"
 #include "evfs/core/time.h"
@@ -359,14 +360,8 @@ void AddCeresLm(const ReconstructionOptions& options, const ReconstructionSummar
   json["threads"] = options.solver.num_threads;
   if (!summary.solved) return;
   json["termination"] = ceres::TerminationTypeToString(summary.ceres.termination_type);
-  // Where Ceres' time went (its own accounting).
-  json["time_s"] = {
-      {"preprocessor", Number(summary.ceres.preprocessor_time_in_seconds)},
-      {"residual_evaluation", Number(summary.ceres.residual_evaluation_time_in_seconds)},
-      {"jacobian_evaluation", Number(summary.ceres.jacobian_evaluation_time_in_seconds)},
-      {"linear_solver", Number(summary.ceres.linear_solver_time_in_seconds)},
-      {"minimizer", Number(summary.ceres.minimizer_time_in_seconds)},
-  };
+  // Where Ceres' time went (its own accounting), and its passes over the residual blocks.
+  json.update(CeresWorkJson(summary.ceres));
   json["successful_steps"] = summary.ceres.num_successful_steps;
   json["unsuccessful_steps"] = summary.ceres.num_unsuccessful_steps;
   json["linear_solver_iterations"] = summary.linear_solver_iterations;

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "evfs/app/run_report.h"
+#include "evfs/app/solver_json.h"
 #include "evfs/app/video_steps.h"
 #include "evfs/app/video_work_folder.h"
 #include "evfs/core/error.h"
@@ -238,6 +239,9 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   record["message"] = run.message;
   record["iterations"] = run.iterations;
   record["linear_solver_iterations"] = run.reconstruction.linear_solver_iterations;
+  if (context.method.method == Method::kCeresLm && run.solved) {
+    record["ceres"] = CeresWorkJson(run.reconstruction.ceres);
+  }
   if (!run.reconstruction.model.description.empty())
     record["model"] = run.reconstruction.model.description;
   record["initial_cost"] = Number(run.initial_cost);

@@ -57,14 +57,16 @@ def write_png(path, rows):
                 + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
 
 def crop(source, target, side, num_frames):
+    """The central SIDE x SIDE pixels (SIDE 'WxH': W x H; 0: the whole frame) of the first frames."""
+    width, height = (int(v) for v in side.split("x")) if "x" in side else (int(side), int(side))
     lines = [l.split() for l in open(os.path.join(source, "images.txt")) if l.strip() and not l.startswith("#")]
     os.makedirs(os.path.join(target, "frames"), exist_ok=True)
     with open(os.path.join(target, "images.txt"), "w") as listing:
         for i, (t, path) in enumerate(lines[:num_frames]):
             rows = read_png(os.path.join(source, path))
-            if side > 0:
-                top, left = max(0, (len(rows) - side) // 2), max(0, (len(rows[0]) - side) // 2)
-                rows = [row[left:left + side] for row in rows[top:top + side]]
+            if width > 0:
+                top, left = max(0, (len(rows) - height) // 2), max(0, (len(rows[0]) - width) // 2)
+                rows = [row[left:left + width] for row in rows[top:top + height]]
             name = "frames/frame_%08d.png" % i
             write_png(os.path.join(target, name), rows)
             listing.write("%s %s\n" % (t, name))
@@ -119,7 +121,7 @@ def camera(simulation, target, step, sharp_frames=None):
 
 if __name__ == "__main__":
     if sys.argv[1] == "crop":
-        crop(sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]))
+        crop(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]))
     elif sys.argv[1] == "camera":
         camera(sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5] if len(sys.argv) > 5 else None)
     else:

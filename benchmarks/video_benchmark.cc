@@ -7,6 +7,7 @@
 // resident memory is its own. Prints a table and writes video_benchmark.csv into --work_dir.
 //
 //   video_benchmark --work_dir=/tmp/vid_bench [--repeats=3] [--denoise=none|auto]
+//   video_benchmark --work_dir=/tmp/vid_bench --recordings_only   (WORK/rec_2s, WORK/rec_20s)
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -34,6 +35,8 @@ DEFINE_string(evfs, EVFS_BINARY, "The evfs binary.");
 DEFINE_int32(repeats, 3, "Runs per row; the table gives medians.");
 DEFINE_int32(width, 64, "Sensor width of the synthetic recordings.");
 DEFINE_int32(height, 48, "Sensor height of the synthetic recordings.");
+DEFINE_bool(recordings_only, false,
+            "Write the two recordings (WORK/rec_2s, WORK/rec_20s) and stop, for other benchmarks.");
 DEFINE_string(denoise, "none",
               "evfs video's --denoise: none (the solve alone), auto (evfs' default: the shipped "
               "denoiser, once) or once.");
@@ -190,6 +193,7 @@ int Main() {
   fs::create_directories(work);
   const Recording short_recording = MakeRecording(work / "rec_2s", 2.0, true);
   const Recording long_recording = MakeRecording(work / "rec_20s", 20.0, false);
+  if (FLAGS_recordings_only) return 0;
 
   std::vector<Row> rows;
   rows.push_back(Measure(short_recording, "2 s", 1, work / "out_2s_j1"));

@@ -3,6 +3,8 @@
 time goes").
 
     benchmarks/where_time_goes.py EVFS [EVFS_BEFORE] [--runs=N] [--data=DIR] [--flags="..."]
+        [--cases=stages|speed|scaling] [--scratch=DIR]
+        [--video_benchmark=BUILD/benchmarks/video_benchmark]
 
 Runs each case N times (default 5), alternating the two binaries when two are given, and prints
 one markdown table per binary of the medians of:
@@ -12,21 +14,34 @@ one markdown table per binary of the medians of:
     Ceres reports (preprocessor, residual and Jacobian evaluation, linear solver);
   * Ceres iterations, conjugate-gradient steps (reconstruct) and the PSNR of the withheld frame
     or frames;
-and, with two binaries, the ratios after / before of the pairs' CPU and wall seconds. --flags
-go to every job of EVFS; with one binary, EVFS with them is compared with EVFS without them
-(e.g. --flags=--preconditioner=SUBSET).
+and, with two binaries, the ratios after / before of the pairs' CPU and wall seconds, peak
+resident memory and, for video, windows per second. --flags go to every job of EVFS
+(--flags_before to EVFS_BEFORE's); with one binary, EVFS with them is compared with EVFS without
+them (e.g. --flags=--preconditioner=SUBSET).
+
+--cases=speed measures the whole-recording speed targets instead: slider, `evfs video --fps=500`
+on shapes and on the video benchmark's 20 s synthetic recording (written once into --scratch by
+`video_benchmark --recordings_only`), both again with --frame_step=2 for the withheld frames'
+PSNR and SSIM, and one DAVIS346-sized window (346 x 260 pixels of the shared adobe240_GOPR9642
+clip's first 3 frames, events from `evfs simulate` of EVFS, also kept in --scratch),
+interpolating frame 1 from 0 and 2. --cases=scaling runs `evfs video --fps=500` on shapes and
+the 20 s recording at --jobs=1 and 2, and under mpirun with 2 and 3 ranks (one and two workers
+beside rank 0, one job each).
 
 The floor of a solve is its evaluations: every Levenberg-Marquardt iteration evaluates the
 residuals and the Jacobian at least once, so "evaluation" (Ceres' residual + Jacobian time) is
-what the solve cannot go below without fewer iterations or cheaper terms. "floor share" is that
-evaluation over all the time Ceres reports (preprocessor + evaluation + linear solver; summed
-over the independent parts, which run in parallel, so these may add to more than "solve").
+what the solve cannot go below without fewer iterations or cheaper terms ("passes": Ceres'
+residual and Jacobian evaluations, each one pass over every residual block; "s per pass" their
+mean time). "floor share" is that evaluation over all the time Ceres reports (preprocessor +
+evaluation + linear solver; summed over the independent parts, which run in parallel, so these
+may add to more than "solve"), and "wall / floor" the whole process's wall time over it (for
+video, over the windows' evaluation divided by the jobs that ran them): how far the job is from
+its floor.
 """
 import argparse
 import json
 import os
 import re
-import resource
 import shutil
 import statistics
 import subprocess
@@ -36,7 +51,7 @@ import time
 
 
 def cases(data):
-    """(name, evfs arguments, kind) of each measured job."""
+    """(name, evfs arguments, kind) of each measured job of --cases=stages."""
     return [
         ("slider 70->71 predict",
          ["reconstruct", f"--data={data}/slider_depth_70_71", "--mode=predict", "--first=0",
@@ -53,41 +68,112 @@ def cases(data):
     ]
 
 
+def speed_inputs(data, scratch, evfs, video_benchmark):
+    """Writes the inputs of --cases=speed and scaling once; returns (20 s recording, DAVIS346)."""
+    recording = os.path.join(scratch, "rec_20s")
+    if not os.path.isdir(recording):
+        if not video_benchmark:
+            sys.exit("where_time_goes: --cases=speed needs --video_benchmark (or SCRATCH/rec_20s)")
+        subprocess.run([video_benchmark, f"--work_dir={scratch}", "--recordings_only",
+                        f"--evfs={evfs}"], check=True, stdout=subprocess.DEVNULL)
+    davis346 = os.path.join(scratch, "davis346_GOPR9642")
+    if not os.path.isfile(os.path.join(davis346, "events.txt")):
+        helper = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                              "realistic_variants_helper.py")
+        crop = os.path.join(scratch, "davis346_crop")
+        subprocess.run([sys.executable, helper, "crop", f"{data}/adobe240_GOPR9642", crop,
+                        "346x260", "3"], check=True)
+        subprocess.run([evfs, "simulate", f"--frames={crop}", f"--out={davis346}",
+                        "--progress_interval_s=0", "--overwrite"], check=True,
+                       stdout=subprocess.DEVNULL)
+    return recording, davis346
+
+
+def speed_cases(data, recording, davis346):
+    """(name, evfs arguments, kind) of each job of --cases=speed."""
+    shapes = f"{data}/shapes_rotation_13_20"
+    video = ["video", "--progress_interval_s=0"]
+    return [
+        ("slider 70->71 predict",
+         ["reconstruct", f"--data={data}/slider_depth_70_71", "--mode=predict", "--first=0",
+          "--last=1", "--truth=1"], "reconstruct"),
+        ("shapes video --fps=500", video + [f"--data={shapes}", "--fps=500"], "video"),
+        ("shapes video --frame_step=2", video + [f"--data={shapes}", "--frame_step=2"], "video"),
+        ("20 s recording video --fps=500", video + [f"--data={recording}", "--fps=500"], "video"),
+        ("20 s recording video --frame_step=2", video + [f"--data={recording}", "--frame_step=2"],
+         "video"),
+        ("DAVIS346 simulated 0,2->1 interpolate",
+         ["reconstruct", f"--data={davis346}", "--mode=interpolate", "--first=0", "--last=2",
+          "--truth=1"], "reconstruct"),
+    ]
+
+
+def scaling_cases(data, recording):
+    """(name, evfs arguments, kind, launcher) of --cases=scaling: `evfs video --fps=500` at
+    --jobs=1 and 2, and under mpirun with one and two worker ranks (one job each)."""
+    mpirun = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np"]
+    jobs = []
+    recordings = (("shapes", f"{data}/shapes_rotation_13_20"), ("20 s recording", recording))
+    for name, folder in recordings:
+        video = ["video", f"--data={folder}", "--fps=500", "--progress_interval_s=0"]
+        jobs += [(f"{name} --jobs=1", video + ["--jobs=1"], "video", []),
+                 (f"{name} --jobs=2", video + ["--jobs=2"], "video", []),
+                 (f"{name} mpirun -np 2 --jobs=1", video + ["--jobs=1"], "video", mpirun + ["2"]),
+                 (f"{name} mpirun -np 3 --jobs=1", video + ["--jobs=1"], "video", mpirun + ["3"])]
+    return jobs
+
+
 def run(command):
-    """Runs `command`; returns (wall s, CPU s of the child, its stdout + stderr)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    """Runs `command`; returns (wall s, CPU s, peak resident MB of the child, its output)."""
     start = time.monotonic()
-    done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    output = child.stdout.read()
+    _, status, usage = os.wait4(child.pid, 0)
     wall = time.monotonic() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    if done.returncode != 0:
-        sys.exit(f"where_time_goes: {' '.join(command)} failed:\n{done.stdout}")
-    return wall, cpu, done.stdout
+    child.returncode = os.waitstatus_to_exitcode(status)
+    cpu = usage.ru_utime + usage.ru_stime
+    if child.returncode != 0:
+        sys.exit(f"where_time_goes: {' '.join(command)} failed:\n{output}")
+    return wall, cpu, usage.ru_maxrss / 1024.0, output
 
 
 def stage_times(out, kind):
-    """Stage and Ceres times, iterations, summed over windows for video."""
+    """Stage and Ceres times, iterations and passes, summed over windows for video."""
     summary = json.load(open(os.path.join(out, "summary.json")))
     records = summary["windows"] if kind == "video" else [summary]
     figures = {}
+
+    def add(name, value):
+        figures[name] = figures.get(name, 0) + value
+
     for record in records:
         for stage, seconds in record["time_s"].items():
             if stage != "total":
-                figures[stage] = figures.get(stage, 0.0) + seconds
-        figures["iterations"] = figures.get("iterations", 0) + record.get("iterations", 0)
-    if kind == "reconstruct":
-        ceres = summary["solver"]["time_s"]
-        figures["preprocessor"] = ceres["preprocessor"]
-        figures["evaluation"] = ceres["residual_evaluation"] + ceres["jacobian_evaluation"]
-        figures["linear solver"] = ceres["linear_solver"]
-        figures["CG steps"] = summary["solver"].get("linear_solver_iterations", float("nan"))
+                add(stage, seconds)
+        add("iterations", record.get("iterations", 0))
+        # Ceres' accounting: summary.json's "solver" (reconstruct), each window's "ceres" (video).
+        ceres = record.get("ceres") if kind == "video" else record.get("solver")
+        if not ceres or "time_s" not in ceres:
+            continue
+        times = ceres["time_s"]
+        add("preprocessor", times["preprocessor"])
+        add("evaluation", times["residual_evaluation"] + times["jacobian_evaluation"])
+        add("linear solver", times["linear_solver"])
+        add("CG steps", ceres.get("linear_solver_iterations", record.get("linear_solver_iterations",
+                                                                        float("nan"))))
+        # Passes over the residual blocks (residual-only and residual + Jacobian evaluations).
+        add("passes", ceres.get("residual_evaluations", float("nan")) +
+            ceres.get("jacobian_evaluations", float("nan")))
+    if figures.get("passes", 0) > 0:
+        figures["s per pass"] = figures["evaluation"] / figures["passes"]
+    # The windows of a video run `jobs` at a time: its floor is their evaluation over the jobs.
+    figures["floor"] = figures.get("evaluation", 0) / summary.get("run", {}).get("jobs", 1)
     return figures
 
 
-def psnr(output):
-    """The PSNR the command printed for its withheld frame(s)."""
-    match = re.search(r"PSNR (?:mean )?([0-9.]+) dB", output)
+def printed(output, pattern):
+    """The number `pattern` (one group) finds in the command's output, or NaN."""
+    match = re.search(pattern, output)
     return float(match.group(1)) if match else float("nan")
 
 
@@ -97,37 +183,59 @@ def main():
     parser.add_argument("evfs_before", nargs="?")
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--flags", default="", help="extra evfs flags of EVFS's runs")
+    parser.add_argument("--flags_before", default="", help="extra evfs flags of EVFS_BEFORE's runs")
     parser.add_argument("--data", default=os.path.join(os.path.dirname(__file__),
                                                        "../../shared/data"))
+    parser.add_argument("--cases", choices=["stages", "speed", "scaling"], default="stages")
+    parser.add_argument("--scratch", help="kept inputs of --cases=speed (default: a temporary one)")
+    parser.add_argument("--video_benchmark", help="the video_benchmark binary (--cases=speed)")
     args = parser.parse_args()
     flags = args.flags.split()
     # (label, binary, extra flags) of each variant; the first is "after".
     variants = [(" ".join([args.evfs] + flags), args.evfs, flags)]
     if args.evfs_before:
-        variants.append((args.evfs_before, args.evfs_before, []))
+        before_flags = args.flags_before.split()
+        variants.append((" ".join([args.evfs_before] + before_flags), args.evfs_before,
+                         before_flags))
     elif flags:
         variants.append((args.evfs, args.evfs, []))
     binaries = [label for label, _, _ in variants]
     scratch = tempfile.mkdtemp(prefix="evfs-time-")
+    if args.cases in ("speed", "scaling"):
+        inputs = os.path.abspath(args.scratch or scratch)
+        os.makedirs(inputs, exist_ok=True)
+        recording, davis346 = speed_inputs(args.data, inputs, args.evfs, args.video_benchmark)
+        jobs = (speed_cases(args.data, recording, davis346) if args.cases == "speed"
+                else scaling_cases(args.data, recording))
+    else:
+        jobs = cases(args.data)
+    jobs = [job if len(job) == 4 else job + ([],) for job in jobs]
     results = {b: {} for b in binaries}  # binary -> case -> list of figure dicts
     try:
         for _ in range(args.runs):
             for label, binary, _ in variants:
-                _, cpu, _ = run([binary, "--version"])
-                results[label].setdefault("start-up", []).append({"cpu": cpu})
-            for name, arguments, kind in cases(args.data):
+                _, cpu, peak, _ = run([binary, "--version"])
+                results[label].setdefault("start-up", []).append({"cpu": cpu, "peak MB": peak})
+            for name, arguments, kind, launcher in jobs:
                 for label, binary, extra in variants:
                     out = os.path.join(scratch, "out")
-                    wall, cpu, output = run([binary] + arguments + extra + [f"--out={out}"])
+                    wall, cpu, peak, output = run(launcher + [binary] + arguments + extra +
+                                              [f"--out={out}"])
                     figures = stage_times(out, kind)
-                    figures.update(wall=wall, cpu=cpu, psnr=psnr(output))
+                    figures.update({"wall": wall, "cpu": cpu, "peak MB": peak,
+                                    "psnr": printed(output, r"PSNR (?:mean )?([0-9.]+) dB"),
+                                    "ssim": printed(output, r"SSIM (?:mean )?([0-9.]+)"),
+                                    "windows_per_s": printed(output, r"([0-9.]+) windows/s")})
+                    if figures["floor"] > 0:
+                        figures["wall / floor"] = wall / figures["floor"]
                     results[label].setdefault(name, []).append(figures)
                     shutil.rmtree(out)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
 
-    columns = ["wall", "cpu", "read", "bin", "build", "solve", "preprocessor", "evaluation",
-               "linear solver", "write", "iterations", "CG steps", "psnr"]
+    columns = ["wall", "cpu", "peak MB", "windows_per_s", "read", "bin", "build", "solve",
+               "preprocessor", "evaluation", "linear solver", "write", "iterations", "passes",
+               "s per pass", "CG steps", "wall / floor", "psnr", "ssim"]
     for binary in binaries:
         print(f"\n{binary} (medians of {args.runs}; seconds, PSNR dB)\n")
         print("| job | " + " | ".join(columns) + " | floor share |")
@@ -136,7 +244,7 @@ def main():
             cells = []
             for column in columns:
                 values = [r[column] for r in runs if column in r and r[column] == r[column]]
-                form = ".2f" if column == "psnr" else ".3g"
+                form = {"psnr": ".2f", "ssim": ".4f"}.get(column, ".3g")
                 cells.append(f"{statistics.median(values):{form}}" if values else "")
             floor = [r["evaluation"] / (r["evaluation"] + r["linear solver"] + r["preprocessor"])
                      for r in runs if "evaluation" in r]
@@ -144,12 +252,14 @@ def main():
             print(f"| {name} | " + " | ".join(cells) + f" | {share} |")
     if len(binaries) == 2:
         print(f"\nafter / before, median of the {args.runs} pairs\n")
-        print("| job | CPU s | wall s |\n| --- | --- | --- |")
+        ratio_columns = ("cpu", "wall", "peak MB", "windows_per_s")
+        print("| job | CPU s | wall s | peak MB | windows/s |\n| --- | --- | --- | --- | --- |")
         for name in results[binaries[0]]:
             pairs = list(zip(results[binaries[0]][name], results[binaries[1]][name]))
             cells = []
-            for figure in ("cpu", "wall"):
-                ratios = [a[figure] / b[figure] for a, b in pairs if figure in a and figure in b]
+            for figure in ratio_columns:
+                ratios = [a[figure] / b[figure] for a, b in pairs
+                          if a.get(figure, 0) == a.get(figure, 0) and b.get(figure, 0) > 0]
                 cells.append(f"x{statistics.median(ratios):.2f}" if ratios else "")
             print(f"| {name} | " + " | ".join(cells) + " |")
 

@@ -70,8 +70,9 @@ class CallbackAdapter : public ceres::IterationCallback {
   bool stopped_ = false;
 };
 
-// Adds a part's Ceres summary to the whole scene's: costs, steps and stage times add up; the
-// worst termination wins (with its message), otherwise the first (largest) part's message.
+// Adds a part's Ceres summary to the whole scene's: costs, steps and stage times add up, the
+// evaluation counts are the most any part made; the worst termination wins (with its message),
+// otherwise the first (largest) part's message.
 void Accumulate(const ceres::Solver::Summary& part, bool first, ceres::Solver::Summary* total) {
   const auto severity = [](ceres::TerminationType type) {
     return type == ceres::FAILURE ? 2 : type == ceres::NO_CONVERGENCE ? 1 : 0;
@@ -96,6 +97,12 @@ void Accumulate(const ceres::Solver::Summary& part, bool first, ceres::Solver::S
   total->residual_evaluation_time_in_seconds += part.residual_evaluation_time_in_seconds;
   total->jacobian_evaluation_time_in_seconds += part.jacobian_evaluation_time_in_seconds;
   total->linear_solver_time_in_seconds += part.linear_solver_time_in_seconds;
+  // Passes over the residual blocks: the most any part made (its own blocks, each pass).
+  total->num_residual_evaluations =
+      std::max(total->num_residual_evaluations, part.num_residual_evaluations);
+  total->num_jacobian_evaluations =
+      std::max(total->num_jacobian_evaluations, part.num_jacobian_evaluations);
+  total->num_linear_solves = std::max(total->num_linear_solves, part.num_linear_solves);
   total->num_parameter_blocks += part.num_parameter_blocks;
   total->num_residual_blocks += part.num_residual_blocks;
 }

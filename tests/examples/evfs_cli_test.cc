@@ -131,6 +131,7 @@ TEST(EvfsCli, ReconstructWritesFramesTimestampsAndSummary) {
   EXPECT_NE(summary.find("\"mode\": \"interpolate\""), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"truth\": {"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"alpha_derived\": true"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"jacobian_evaluations\": "), std::string::npos) << summary;
   const std::string timestamps = ReadFile(out + "/timestamps.txt");
   const int lines = static_cast<int>(std::count(timestamps.begin(), timestamps.end(), '\n'));
   int pngs = 0;

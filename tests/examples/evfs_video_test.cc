@@ -112,6 +112,9 @@ TEST(EvfsVideo, AWholeRecordingBecomesUniformFramesWithTheObservedOnesUnchanged)
     EXPECT_EQ(window["frames"][1]["index"], i + 1);
     EXPECT_GT(window["events"].get<int64_t>(), 0);
     EXPECT_GE(window["latent_frames"].get<int>(), 2);
+    // Ceres' own accounting: the Jacobian is evaluated at the start at least.
+    EXPECT_GE(window["ceres"]["jacobian_evaluations"].get<int>(), 1);
+    EXPECT_GE(window["ceres"]["time_s"]["linear_solver"].get<double>(), 0.0);
   }
   EXPECT_TRUE(summary["video"]["codec"] == "avc1" || summary["video"]["codec"] == "mp4v");
   EXPECT_GT(fs::file_size(out / "video.mp4"), 0u);
