@@ -392,6 +392,13 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           "With merged quiet steps, a pixel near the events that never fires gets one change after "
           "the last frame, at the median of its neighbours' events (false: it stays constant).",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.unfired_pixel_changes)),
+      Row("ring_tolerance", "model", "reconstruct video", kReconstructKey,
+          Double(ReconstructionOptions().ring_tolerance, ValueRange::Between(0.0, 1.0)),
+          "With merged quiet steps, a pixel held constant next to the solved ones (the ring) "
+          "enters the problem as one constant until its initial value has moved more than this "
+          "(intensity in [0, 1]; 0: a new constant at every change). The output keeps the ring's "
+          "own values.",
+          EVFS_OPTION_FIELD(reconstruct.method.reconstruction.ring_tolerance)),
       Row("split_independent_parts", "model", "reconstruct video", kReconstructKey,
           Bool(ReconstructionOptions().split_independent_parts),
           "Solve the regions that no term couples as separate problems, concurrently (one after "

@@ -62,7 +62,7 @@ std::vector<int> UnfiredChangeFrames(const Scene& scene, const ActivityMask& mas
 }  // namespace
 
 LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const Video& initial,
-                           bool merge_quiet_steps, bool unfired_changes)
+                           bool merge_quiet_steps, bool unfired_changes, double ring_tolerance)
     : num_latent_frames_(scene.num_latent_frames()),
       pixels_per_frame_(static_cast<int64_t>(scene.height) * scene.width) {
   const int num_latent = num_latent_frames_;
@@ -100,12 +100,16 @@ LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const V
         }
       }
     }
+    // A ring pixel's segment holds while its initial value stays within `ring_tolerance` of its
+    // value where the segment began; the problem sees the segment's mean (Segment::held).
+    std::vector<double> held(initial.frame_data(0), initial.frame_data(0) + pixels);
     for (int t = 1; t < num_latent; ++t) {
       const double* now = initial.frame_data(t);
-      const double* before = initial.frame_data(t - 1);
       for (int64_t p = 0; p < pixels; ++p) {
-        if (mask.role(p) == ActivityMask::Role::kRing && now[p] != before[p]) {
+        if (mask.role(p) == ActivityMask::Role::kRing &&
+            std::abs(now[p] - held[p]) > ring_tolerance) {
           starts[t * pixels + p] = kStarts;
+          held[p] = now[p];
         }
       }
     }
@@ -132,7 +136,13 @@ LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const V
   if (segments_.size() > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
     throw InvalidArgumentError("latent layout: too many segments");
   }
-  for (const Segment& segment : segments_) num_variable_segments_ += !segment.constant;
+  for (Segment& segment : segments_) {
+    num_variable_segments_ += !segment.constant;
+    if (!segment.constant) continue;
+    double sum = 0.0;
+    for (int t = segment.first; t <= segment.last; ++t) sum += initial.frame_data(t)[segment.pixel];
+    segment.held = sum / segment.length();
+  }
 }
 
 void LatentLayout::ProjectOnto(Video* latent) const {
@@ -147,6 +157,7 @@ void LatentLayout::ProjectOnto(Video* latent) const {
 
 void LatentLayout::Expand(Video* latent) const {
   for (const Segment& segment : segments_) {
+    if (segment.constant) continue;  // a ring pixel's voxels keep their initial values
     const double value = latent->frame_data(segment.first)[segment.pixel];
     for (int t = segment.first + 1; t <= segment.last; ++t) {
       latent->frame_data(t)[segment.pixel] = value;

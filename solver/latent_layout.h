@@ -4,7 +4,10 @@
 // Each pixel in the problem has its time series H_0(p) … H_K(p) cut into segments of
 // consecutive latent frames that share one value. An active pixel starts a new segment only at
 // a latent step inside an event frame that fired at the pixel: between its events the pixel
-// is constant. A ring pixel (held constant) starts one where its initial value changes.
+// is constant. A ring pixel (held constant) starts one where its initial value has moved more
+// than a tolerance: each of its segments enters its neighbours' spatial TV as one constant, and
+// every segment there cuts their TV runs, so a ring that followed every small change of a
+// blended initialisation would multiply the spatial TV terms by the latent frames.
 //
 // Why merging quiet steps changes the reconstruction so little: at a step where the pixel did not
 // fire, any change d costs λ_e|tanh(α d)| + λ_t|d| (event and temporal terms), more than the
@@ -43,6 +46,8 @@ class LatentLayout {
     int first = 0;          // first latent frame
     int last = 0;           // last latent frame (inclusive)
     bool constant = false;  // a ring pixel's segment: held at its initial value
+    /// A constant's value in the problem: the mean of the initial video over the segment.
+    double held = 0.0;
     /// The segment begins with an unfired pixel's change (no event residual there).
     bool unfired_change = false;
     int length() const { return last - first + 1; }
@@ -51,9 +56,11 @@ class LatentLayout {
   /// Segments for every pixel the mask puts in the problem. With `merge_quiet_steps` false every
   /// voxel is its own segment (the plain per-voxel layout). `initial` is the initial latent video
   /// (for ring pixels' constants). `unfired_changes` (merged layout only): unfired pixels next to
-  /// events after the last frame get one change (above).
+  /// events after the last frame get one change (above). `ring_tolerance` (merged layout only):
+  /// a ring pixel starts a new constant where its initial value moves more than this from the
+  /// value it had where the constant began (0: wherever it changes).
   LatentLayout(const Scene& scene, const ActivityMask& mask, const Video& initial,
-               bool merge_quiet_steps, bool unfired_changes = false);
+               bool merge_quiet_steps, bool unfired_changes = false, double ring_tolerance = 0.0);
 
   int num_latent_frames() const { return num_latent_frames_; }
   int64_t pixels_per_frame() const { return pixels_per_frame_; }
@@ -66,15 +73,19 @@ class LatentLayout {
     return segment_of_voxel_[static_cast<size_t>(t) * pixels_per_frame_ + p];
   }
 
-  /// The storage of segment s inside `latent`: the voxel of its first frame.
+  /// The storage of segment s: the voxel of its first frame inside `latent`, or for a constant
+  /// its held value (a parameter block Ceres never changes; the voxels keep their own values).
   double* value(int64_t s, Video* latent) const {
-    return latent->frame_data(segments_[s].first) + segments_[s].pixel;
+    const Segment& segment = segments_[s];
+    if (segment.constant) return const_cast<double*>(&segment.held);
+    return latent->frame_data(segment.first) + segment.pixel;
   }
 
   /// Sets every variable segment's value to the mean of `latent` over the segment, so that the
   /// initialisation is a point of the merged parameter space.
   void ProjectOnto(Video* latent) const;
-  /// Copies each segment's value to every voxel of the segment (after a solve).
+  /// Copies each variable segment's value to every voxel of the segment (after a solve); a ring
+  /// pixel's voxels keep their own values.
   void Expand(Video* latent) const;
 
  private:

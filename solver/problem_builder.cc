@@ -105,8 +105,9 @@ ProblemPlan ProblemBuilder::Prepare(Video* latent) const {
   }
   ProblemPlan prepared;
   prepared.mask_ = std::make_shared<ActivityMask>(scene_.events, options_.activity_radius_px);
-  auto layout = std::make_shared<LatentLayout>(
-      scene_, *prepared.mask_, *latent, options_.merge_quiet_steps, options_.unfired_pixel_changes);
+  auto layout =
+      std::make_shared<LatentLayout>(scene_, *prepared.mask_, *latent, options_.merge_quiet_steps,
+                                     options_.unfired_pixel_changes, options_.ring_tolerance);
   layout->ProjectOnto(latent);
   prepared.layout_ = std::move(layout);
   prepared.terms_ = std::make_shared<ObjectiveTerms>(scene_, options_.objective, *prepared.mask_);

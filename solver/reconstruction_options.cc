@@ -102,6 +102,7 @@ bool ReconstructionOptions::IsValid(std::string* error) const {
                 "every smoothing_continuation scale must be positive and finite");
   }
   check.Check(min_part_pixels >= 1, "min_part_pixels must be at least 1")
+      .Check(ring_tolerance >= 0.0 && ring_tolerance <= 1.0, "ring_tolerance must be in [0, 1]")
       .Check(quiet_blend_fraction >= 0.0 && quiet_blend_fraction <= kMaxQuietBlendFraction,
              "quiet_blend_fraction must be in [0, 100]")
       .Check(step_ramp_px >= 0.0 && step_ramp_px <= kMaxStepRampPx,

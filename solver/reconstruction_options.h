@@ -115,6 +115,15 @@ struct ReconstructionOptions {
   /// "Unfired pixels after the last frame".
   bool unfired_pixel_changes = true;
 
+  /// With merged quiet steps, a ring pixel (held constant next to the solved ones) starts a new
+  /// constant only where its initial value has moved more than this (intensity, [0, 1]) since
+  /// the current one began; the problem sees each constant's mean, the output keeps the ring's
+  /// own values (LatentLayout). One 8-bit grey level, what the frames resolve. 0: a new constant
+  /// at every change, which for a blended initialisation is every latent frame and multiplies
+  /// the spatial TV terms next to the ring by the latent frames. Ceres' problem only: the fused
+  /// objective of the first-order solvers sees every ring voxel.
+  double ring_tolerance = 1.0 / 255.0;
+
   /// Solve separately, on solver.num_threads threads, the parts of the scene that no term
   /// couples (ActivityMask::IndependentParts): each stops at its own convergence and the
   /// threads share the work. With an iteration callback the parts are solved one after another

@@ -114,6 +114,42 @@ TEST(ProblemBuilder, PixelsFarFromEventsAreSkipped) {
   EXPECT_EQ(stats.spatial_tv_residuals, kLatent * (9 + 9));
 }
 
+TEST(ProblemBuilder, RingPixelsAreOneConstantWhileTheirInitialValueHolds) {
+  // Radius 1: 9 active pixels and 7 ring pixels (PixelsFarFromEventsAreSkipped). The blend
+  // moves every ring pixel by 0.4 / 3 per latent frame: 0.2, 0.333, 0.467, 0.6.
+  const Scene scene = MakeTinyScene();
+  ReconstructionOptions options;
+  options.objective.event_model.alpha = 5.0;
+  options.activity_radius_px = 1;
+  const auto build = [&](double tolerance, Video* latent) {
+    options.ring_tolerance = tolerance;
+    return ProblemBuilder(scene, options).Build(latent);
+  };
+  Video every_change = InitializeLatentVideo(scene);
+  Video one_constant = every_change, two_constants = every_change;
+  const auto exact = build(0.0, &every_change);   // a constant per latent frame
+  const auto held = build(0.5, &one_constant);    // one constant per ring pixel
+  const auto split = build(0.2, &two_constants);  // frames 0..1 and 2..3
+  const int64_t unknowns = exact->statistics().variable_parameter_blocks;
+  EXPECT_EQ(held->statistics().variable_parameter_blocks, unknowns);
+  EXPECT_EQ(split->statistics().variable_parameter_blocks, unknowns);
+  EXPECT_EQ(exact->statistics().parameter_blocks, unknowns + 7 * 4);
+  EXPECT_EQ(held->statistics().parameter_blocks, unknowns + 7);
+  EXPECT_EQ(split->statistics().parameter_blocks, unknowns + 7 * 2);
+  // Each ring constant cuts the spatial TV runs of its active neighbours.
+  EXPECT_LT(held->statistics().spatial_tv_residuals, split->statistics().spatial_tv_residuals);
+  EXPECT_LT(split->statistics().spatial_tv_residuals, exact->statistics().spatial_tv_residuals);
+
+  // The problem sees each constant's mean; the ring's voxels keep their own values.
+  const LatentLayout& layout = split->layout();
+  const int64_t ring = 1;  // (y 0, x 1)
+  const double step = 0.4 / 3.0;
+  EXPECT_NEAR(*layout.value(layout.segment_at(0, ring), &two_constants), 0.2 + step / 2, 1e-12);
+  EXPECT_NEAR(*layout.value(layout.segment_at(3, ring), &two_constants), 0.6 - step / 2, 1e-12);
+  layout.Expand(&two_constants);
+  for (int t = 0; t < 4; ++t) EXPECT_NEAR(two_constants.at(t, 0, 1), 0.2 + step * t, 1e-12);
+}
+
 TEST(ProblemBuilder, MergedLayoutHasOneUnknownPerQuietRun) {
   // The one event (x 3, y 2, step 1 → 2) splits its pixel into H_0..1 and H_2..3; every other
   // pixel is one constant-in-time unknown.
@@ -295,6 +331,8 @@ TEST(ProblemBuilder, MergedProblemIsTheFullProblemOnSegmentConstantVideos) {
   // An unfired pixel's change has no event residual, by design a different objective (tested
   // in UnfiredPixelsChangeOnce...): compare the plain merge.
   options.unfired_pixel_changes = false;
+  // The full problem sees every ring voxel: so must the merged one.
+  options.ring_tolerance = 0.0;
   Video merged_video = InitializeLatentVideo(scene);
   const auto merged = ProblemBuilder(scene, options).Build(&merged_video);
   const LatentLayout& layout = merged->layout();
