@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "evfs/app/frame_lag.h"
-#include "evfs/app/solver_json.h"
+#include "evfs/app/summary_json.h"
 #include "evfs/core/error.h"
 #include "evfs/core/metrics.h"
 #include "evfs/core/time.h"
@@ -345,9 +345,6 @@ ReconstructResult RunReconstruction(const ReconstructRequest& request, const Dat
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-// JSON has no inf or nan: they become null.
-Json Number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
 
 void AddCeresLm(const ReconstructionOptions& options, const ReconstructionSummary& summary,
                 Json* solver) {

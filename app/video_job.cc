@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "evfs/app/run_report.h"
-#include "evfs/app/solver_json.h"
+#include "evfs/app/summary_json.h"
 #include "evfs/app/video_steps.h"
 #include "evfs/app/video_work_folder.h"
 #include "evfs/core/error.h"
@@ -35,9 +35,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
-
-// JSON has no inf or nan: they become null.
-Json Number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
 
 std::string FrameName(int64_t n) {
   char name[32];

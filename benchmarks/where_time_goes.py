@@ -40,6 +40,7 @@ its floor.
 """
 import argparse
 import json
+import math
 import os
 import re
 import shutil
@@ -50,12 +51,17 @@ import tempfile
 import time
 
 
+def slider_case(data):
+    """The slider 70->71 prediction, a job of every case set."""
+    return ("slider 70->71 predict",
+            ["reconstruct", f"--data={data}/slider_depth_70_71", "--mode=predict", "--first=0",
+             "--last=1", "--truth=1"], "reconstruct")
+
+
 def cases(data):
     """(name, evfs arguments, kind) of each measured job of --cases=stages."""
     return [
-        ("slider 70->71 predict",
-         ["reconstruct", f"--data={data}/slider_depth_70_71", "--mode=predict", "--first=0",
-          "--last=1", "--truth=1"], "reconstruct"),
+        slider_case(data),
         ("shapes 18,20->19 interpolate",
          ["reconstruct", f"--data={data}/shapes_rotation_13_20", "--mode=interpolate",
           "--first=2", "--last=4", "--truth=3"], "reconstruct"),
@@ -94,9 +100,7 @@ def speed_cases(data, recording, davis346):
     shapes = f"{data}/shapes_rotation_13_20"
     video = ["video", "--progress_interval_s=0"]
     return [
-        ("slider 70->71 predict",
-         ["reconstruct", f"--data={data}/slider_depth_70_71", "--mode=predict", "--first=0",
-          "--last=1", "--truth=1"], "reconstruct"),
+        slider_case(data),
         ("shapes video --fps=500", video + [f"--data={shapes}", "--fps=500"], "video"),
         ("shapes video --frame_step=2", video + [f"--data={shapes}", "--frame_step=2"], "video"),
         ("20 s recording video --fps=500", video + [f"--data={recording}", "--fps=500"], "video"),
@@ -259,7 +263,7 @@ def main():
             cells = []
             for figure in ratio_columns:
                 ratios = [a[figure] / b[figure] for a, b in pairs
-                          if a.get(figure, 0) == a.get(figure, 0) and b.get(figure, 0) > 0]
+                          if not math.isnan(a.get(figure, math.nan)) and b.get(figure, 0) > 0]
                 cells.append(f"x{statistics.median(ratios):.2f}" if ratios else "")
             print(f"| {name} | " + " | ".join(cells) + " |")
 

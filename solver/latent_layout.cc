@@ -102,14 +102,14 @@ LatentLayout::LatentLayout(const Scene& scene, const ActivityMask& mask, const V
     }
     // A ring pixel's segment holds while its initial value stays within `ring_tolerance` of its
     // value where the segment began; the problem sees the segment's mean (Segment::held).
-    std::vector<double> held(initial.frame_data(0), initial.frame_data(0) + pixels);
+    std::vector<double> began_at(initial.frame_data(0), initial.frame_data(0) + pixels);
     for (int t = 1; t < num_latent; ++t) {
       const double* now = initial.frame_data(t);
       for (int64_t p = 0; p < pixels; ++p) {
         if (mask.role(p) == ActivityMask::Role::kRing &&
-            std::abs(now[p] - held[p]) > ring_tolerance) {
+            std::abs(now[p] - began_at[p]) > ring_tolerance) {
           starts[t * pixels + p] = kStarts;
-          held[p] = now[p];
+          began_at[p] = now[p];
         }
       }
     }

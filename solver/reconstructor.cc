@@ -102,7 +102,6 @@ void Accumulate(const ceres::Solver::Summary& part, bool first, ceres::Solver::S
       std::max(total->num_residual_evaluations, part.num_residual_evaluations);
   total->num_jacobian_evaluations =
       std::max(total->num_jacobian_evaluations, part.num_jacobian_evaluations);
-  total->num_linear_solves = std::max(total->num_linear_solves, part.num_linear_solves);
   total->num_parameter_blocks += part.num_parameter_blocks;
   total->num_residual_blocks += part.num_residual_blocks;
 }
