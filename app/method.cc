@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "evfs/baselines/baseline.h"
 #include "evfs/core/error.h"
@@ -62,9 +63,10 @@ IterationCallback Observer(const IterationCallback& progress, bool record_checkp
   };
 }
 
-void RunCeresLm(const Scene& scene, const MethodOptions& options, const Video& initial,
+void RunCeresLm(const Scene& scene, const MethodOptions& options, Video initial,
                 const IterationCallback& observer, MethodResult* result) {
-  Reconstruction reconstruction = Reconstruct(scene, options.reconstruction, &initial, observer);
+  Reconstruction reconstruction =
+      Reconstruct(scene, options.reconstruction, std::move(initial), observer);
   const ReconstructionSummary& summary = reconstruction.summary;
   result->video = std::move(reconstruction.video);
   result->solved = summary.solved;
@@ -81,12 +83,12 @@ void RunCeresLm(const Scene& scene, const MethodOptions& options, const Video& i
   result->reconstruction = summary;
 }
 
-void RunFirstOrder(const Scene& scene, const MethodOptions& options, const Video& initial,
+void RunFirstOrder(const Scene& scene, const MethodOptions& options, Video initial,
                    const IterationCallback& observer, MethodResult* result) {
   ReconstructionSummary& summary = result->reconstruction;
   const ObjectiveOptions objective =
       ResolveObjective(scene, options.reconstruction, &summary.model, &summary.alpha_derived);
-  result->video = initial;
+  result->video = std::move(initial);
   if (scene.num_events == 0) {
     result->message = "no events in the window: the initialisation is the answer";
     summary.skipped_reason = result->message;
@@ -209,14 +211,14 @@ MethodResult RunMethod(const Scene& scene, const MethodOptions& given_options,
                            truth->latent_index >= scene.num_latent_frames())) {
     throw InvalidArgumentError("checkpoint truth: no image or a latent index off the timeline");
   }
-  const Video initial =
+  Video initial =
       InitialLatentVideo(scene, options.initialization, options.baseline, &result.initialization);
   const IterationCallback observer =
       Observer(progress, record_checkpoints, truth, &result.checkpoints);
   if (options.method == Method::kCeresLm) {
-    RunCeresLm(scene, options, initial, observer, &result);
+    RunCeresLm(scene, options, std::move(initial), observer, &result);
   } else {
-    RunFirstOrder(scene, options, initial, observer, &result);
+    RunFirstOrder(scene, options, std::move(initial), observer, &result);
   }
   return result;
 }

@@ -294,12 +294,12 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   CountSceneEvents(scene, &result);
   result.time.bin_s = SecondsSince(bin_start);
 
-  result.baseline = InitializeLatentVideo(scene);
   CheckpointTruth checkpoint_truth;
   if (score) {
     result.truth.timestamp_ns = TruthTimestamp(source, request, timing, inputs);
     checkpoint_truth.image = &truth_image;
-    checkpoint_truth.latent_index = result.baseline.NearestFrame(result.truth.timestamp_ns);
+    checkpoint_truth.latent_index =
+        NearestTimestamp(scene.latent_timestamps_ns(), result.truth.timestamp_ns);
   }
   CheckMethodSupports(request.method.method, scene, "this case");
   stage(request.progress ? "build" : "build and solve");
@@ -317,6 +317,8 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   }
   ApplySharpFrameSeams(scene, request.method, &result.run);
 
+  // Made after the solve, so that the solve does not hold a third latent video.
+  result.baseline = InitializeLatentVideo(scene);
   const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
   const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(request.method, result.run),

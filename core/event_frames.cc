@@ -10,6 +10,11 @@ int EventFrames::AddFrame(const EventFrameSpan& span) {
   return num_frames() - 1;
 }
 
+void EventFrames::Reserve(int num_frames) {
+  spans_.reserve(static_cast<size_t>(num_frames));
+  values_.reserve(static_cast<size_t>(num_frames) * static_cast<size_t>(pixels_per_frame()));
+}
+
 double EventFrames::TotalAbsoluteValue() const {
   double total = 0.0;
   for (const float v : values_) total += std::abs(v);

@@ -35,6 +35,9 @@ class EventFrames {
 
   /// Appends an all-zero frame with the given span and returns its index.
   int AddFrame(const EventFrameSpan& span);
+  /// Makes room for `num_frames` frames in all, so that adding them allocates once (growing one
+  /// frame at a time would hold up to twice the voxels).
+  void Reserve(int num_frames);
 
   const EventFrameSpan& span(int k) const { return spans_[k]; }
   EventFrameSpan& span(int k) { return spans_[k]; }

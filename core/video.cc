@@ -30,13 +30,13 @@ void Video::AppendFrame(const Image& image, int64_t timestamp_ns) {
   timestamps_ns_.push_back(timestamp_ns);
 }
 
-int Video::NearestFrame(int64_t t_ns) const {
-  const auto upper = std::lower_bound(timestamps_ns_.begin(), timestamps_ns_.end(), t_ns);
-  if (upper == timestamps_ns_.begin()) return 0;
-  if (upper == timestamps_ns_.end()) return num_frames() - 1;
-  const int after = static_cast<int>(upper - timestamps_ns_.begin());
+int NearestTimestamp(const std::vector<int64_t>& timestamps_ns, int64_t t_ns) {
+  const auto upper = std::lower_bound(timestamps_ns.begin(), timestamps_ns.end(), t_ns);
+  if (upper == timestamps_ns.begin()) return 0;
+  if (upper == timestamps_ns.end()) return static_cast<int>(timestamps_ns.size()) - 1;
+  const int after = static_cast<int>(upper - timestamps_ns.begin());
   const int before = after - 1;
-  return (t_ns - timestamps_ns_[before] <= timestamps_ns_[after] - t_ns) ? before : after;
+  return (t_ns - timestamps_ns[before] <= timestamps_ns[after] - t_ns) ? before : after;
 }
 
 void Video::InterpolationFrames(int64_t t_ns, int* before, int* after, double* weight_after) const {

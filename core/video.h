@@ -14,6 +14,10 @@ using Image = Eigen::Array<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMaj
 using ImageMap = Eigen::Map<Image>;
 using ConstImageMap = Eigen::Map<const Image>;
 
+/// Index of the timestamp in `timestamps_ns` (increasing, not empty) nearest to `t_ns` (ties
+/// go to the earlier one).
+int NearestTimestamp(const std::vector<int64_t>& timestamps_ns, int64_t t_ns);
+
 class Video {
  public:
   Video() = default;
@@ -47,7 +51,7 @@ class Video {
   void AppendFrame(const Image& image, int64_t timestamp_ns);
 
   /// Index of the frame whose timestamp is nearest to `t_ns` (ties go to the earlier frame).
-  int NearestFrame(int64_t t_ns) const;
+  int NearestFrame(int64_t t_ns) const { return NearestTimestamp(timestamps_ns_, t_ns); }
 
   /// Linear interpolation between the two frames around `t_ns` (clamped at the ends).
   Image InterpolateAt(int64_t t_ns) const;

@@ -240,6 +240,9 @@ EventFrames BinByCollision(const EventStream& events, int64_t t_begin_ns, int64_
   }
 
   EventFrames frames(events.height(), events.width());
+  int64_t num_frames = 0;
+  for (const int64_t frame_parts : parts) num_frames += frame_parts;
+  frames.Reserve(static_cast<int>(num_frames));
   std::vector<int64_t> latent_timestamps_ns;
   latent_timestamps_ns.reserve(static_cast<size_t>(num_steps) + 1);
   for (size_t k = 0; k < num_collision; ++k) {
@@ -318,6 +321,7 @@ EventFrames BinStacked(const EventStream& events, int64_t t_begin_ns, int64_t t_
   latent_timestamps_ns.push_back(t_end_ns);
 
   EventFrames frames(events.height(), events.width());
+  frames.Reserve(num_frames);
   size_t frame_first = range.first;
   for (int m = 0; m < num_frames; ++m) {
     const size_t frame_last =

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "evfs/core/error.h"
@@ -343,6 +344,12 @@ bool BuildAndSolve(const Scene& scene, const ReconstructionOptions& solve_option
 
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
                            const Video* initial, const IterationCallback& callback) {
+  return Reconstruct(scene, options, initial != nullptr ? *initial : InitializeLatentVideo(scene),
+                     callback);
+}
+
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options, Video initial,
+                           const IterationCallback& callback) {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgumentError("invalid options: " + error);
   Reconstruction result;
@@ -350,15 +357,11 @@ Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& opti
   solve_options.objective =
       ResolveObjective(scene, options, &result.summary.model, &result.summary.alpha_derived);
 
-  if (initial != nullptr) {
-    if (initial->num_frames() != scene.num_latent_frames() || initial->height() != scene.height ||
-        initial->width() != scene.width) {
-      throw InvalidArgumentError("the initial video does not match the scene's latent timeline");
-    }
-    result.video = *initial;
-  } else {
-    result.video = InitializeLatentVideo(scene);
+  if (initial.num_frames() != scene.num_latent_frames() || initial.height() != scene.height ||
+      initial.width() != scene.width) {
+    throw InvalidArgumentError("the initial video does not match the scene's latent timeline");
   }
+  result.video = std::move(initial);
   ReconstructionSummary& summary = result.summary;
   if (scene.num_events == 0) {
     summary.skipped_reason = "no events in the window: the initialisation is the answer";

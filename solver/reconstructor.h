@@ -54,6 +54,10 @@ struct Reconstruction {
 Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options,
                            const Video* initial = nullptr,
                            const IterationCallback& callback = nullptr);
+/// The same, starting from `initial`, which the reconstruction takes over (no second copy of
+/// the latent video is held while it solves).
+Reconstruction Reconstruct(const Scene& scene, const ReconstructionOptions& options, Video initial,
+                           const IterationCallback& callback = nullptr);
 
 /// options.objective with α derived from `scene` (EstimateEventModel) when it is <= 0; `model`
 /// says what was used and how, `alpha_derived` whether it was derived.

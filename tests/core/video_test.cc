@@ -39,6 +39,8 @@ TEST(Video, NearestFrameAndInterpolation) {
   EXPECT_EQ(video.NearestFrame(50), 0);  // ties go to the earlier frame
   EXPECT_EQ(video.NearestFrame(51), 1);
   EXPECT_EQ(video.NearestFrame(1000), 2);
+  EXPECT_EQ(NearestTimestamp(video.timestamps_ns(), 150), 1);  // the same rule on timestamps
+  EXPECT_EQ(NearestTimestamp({7}, -3), 0);
   EXPECT_DOUBLE_EQ(video.InterpolateAt(25)(0, 0), 0.25);
   EXPECT_DOUBLE_EQ(video.InterpolateAt(150)(0, 0), 0.5);
   EXPECT_DOUBLE_EQ(video.InterpolateAt(-10)(0, 0), 0.0);

@@ -53,6 +53,24 @@ TEST(Reconstructor, InterpolationBeatsTheBlend) {
   EXPECT_GE(solved, blend + kMinGainOverBlendDb);
 }
 
+TEST(Reconstructor, AnInitialVideoHandedOverSolvesAsOnePointedTo) {
+  const test::SyntheticRecording recording;
+  const Scene scene = MakeInterpolationScene(recording.Sharp(0), recording.Sharp(20),
+                                             recording.events, BinningOptions());
+  Video initial = InitializeLatentVideo(scene);
+  initial.frame(initial.num_frames() / 2).array() += 0.05;
+  ReconstructionOptions options;
+  options.solver.num_threads = 1;  // the same sums in the same order: equal to the last bit
+  const Reconstruction pointed = Reconstruct(scene, options, &initial);
+  const Reconstruction handed = Reconstruct(scene, options, Video(initial));
+  ASSERT_TRUE(handed.summary.solved);
+  EXPECT_EQ(handed.summary.initial_cost, pointed.summary.initial_cost);
+  EXPECT_EQ(handed.summary.final_cost, pointed.summary.final_cost);
+  EXPECT_TRUE((VoxelValues(handed.video) == VoxelValues(pointed.video)).all());
+  EXPECT_THROW(Reconstruct(scene, ReconstructionOptions(), Video(scene.height, scene.width, 2)),
+               InvalidArgumentError);
+}
+
 TEST(Reconstructor, SharedStructureTvKeepsTheTextureBothFramesShow) {
   // A static random texture that both frames show, two events and every pixel active: plain
   // spatial TV flattens the texture between the frames, TV measured from the structure the
