@@ -195,18 +195,13 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(context.method, run));
 
   const auto write_start = Clock::now();
-  // The confidence map first: a frame whose image exists is complete (--resume reads that).
+  // Written in place: --resume trusts a window only through its record, written last and
+  // atomically (below), and solves a window without one again, rewriting its frames.
   for (const auto& [folder, video] :
        {std::pair<const char*, const Video*>{"confidence", &sigma}, {"frames", &latent}}) {
     for (int64_t n = begin; n < end; ++n) {
-      const fs::path final_path = context.work / folder / (FrameName(n) + ".png");
-      const fs::path temporary = context.work / folder / (FrameName(n) + ".tmp.png");
-      WriteGreyPng16(temporary.string(), video->InterpolateAt(context.clock->TimeNs(n)));
-      std::error_code error;
-      fs::rename(temporary, final_path, error);
-      if (error) {
-        throw InputError(InputError::Kind::kUnwritable, final_path.string(), 0, error.message());
-      }
+      WriteGreyPng16((context.work / folder / (FrameName(n) + ".png")).string(),
+                     video->InterpolateAt(context.clock->TimeNs(n)));
     }
   }
   const double write_s = SecondsSince(write_start);

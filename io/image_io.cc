@@ -41,10 +41,8 @@ cv::Mat ToMat(const Image& image, int type, double max_value) {
   cv::Mat mat(static_cast<int>(image.rows()), static_cast<int>(image.cols()), type);
   for (int y = 0; y < mat.rows; ++y) {
     Pixel* row = mat.ptr<Pixel>(y);
-    for (int x = 0; x < mat.cols; ++x) {
-      const double value = std::min(1.0, std::max(0.0, image(y, x)));
-      row[x] = static_cast<Pixel>(std::lround(value * max_value));
-    }
+    for (int x = 0; x < mat.cols; ++x)
+      row[x] = static_cast<Pixel>(IntensityLevel(image(y, x), max_value));
   }
   return mat;
 }

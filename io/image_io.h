@@ -32,6 +32,14 @@ Image ReadGreyImage(const std::string& path, int expected_width = 0, int expecte
 /// 8 when every value is k / 255 for an integer k in [0, 255], else 16.
 int MinimalBitDepth(const Image& image);
 
+/// The level of `value` clamped to [0, 1] and scaled by `max_level`, rounded half away from zero
+/// (std::lround's rule) without a call into libm: the conversion of every written pixel.
+inline int64_t IntensityLevel(double value, double max_level) {
+  const double scaled = (value > 0.0 ? (value < 1.0 ? value : 1.0) : 0.0) * max_level;
+  const int64_t whole = static_cast<int64_t>(scaled);                   // the floor, as scaled >= 0
+  return whole + (scaled - static_cast<double>(whole) >= 0.5 ? 1 : 0);  // the difference is exact
+}
+
 /// Writes a 16-bit grey PNG: values clamped to [0, 1], scaled by 65535 and rounded.
 /// Throws InputError(kUnwritable).
 void WriteGreyPng16(const std::string& path, const Image& image);

@@ -11,6 +11,7 @@
 
 #include "evfs/core/error.h"
 #include "evfs/core/plugin.h"
+#include "evfs/io/image_io.h"
 #include "evfs/io/mp4_encoder_plugin.h"
 
 namespace evfs {
@@ -81,8 +82,8 @@ void Mp4Writer::WriteGrey(const Image& image) {
   unsigned char* pixel = bgr_.data();
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x, pixel += 3) {
-      const double value = std::clamp(image(y, x), 0.0, 1.0);
-      pixel[0] = pixel[1] = pixel[2] = static_cast<unsigned char>(std::lround(value * 255.0));
+      pixel[0] = pixel[1] = pixel[2] =
+          static_cast<unsigned char>(IntensityLevel(image(y, x), 255.0));
     }
   }
   WriteBgr(bgr_.data());

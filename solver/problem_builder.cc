@@ -1,9 +1,10 @@
 #include "evfs/solver/problem_builder.h"
 
 #include <algorithm>
-#include <functional>
+#include <cstdint>
+#include <cstring>
 #include <initializer_list>
-#include <tuple>
+#include <unordered_map>
 #include <utility>
 
 #include "evfs/core/error.h"
@@ -31,26 +32,76 @@ class CostFunctionCache {
   explicit CostFunctionCache(std::vector<std::unique_ptr<ceres::CostFunction>>* owned)
       : owned_(owned) {}
 
+  // The cost function of (family, value, shape), made by create() the first time it is asked
+  // for. A lookup allocates nothing: a problem asks once per residual block.
+  template <typename Create>
   ceres::CostFunction* Get(Family family, double value, const std::vector<int>& shape,
-                           const std::function<ceres::CostFunction*()>& create) {
-    return Get(family, value, 0.0, shape, create);
+                           const Create& create) {
+    return Find(family, value, 0.0, shape.data(), shape.size(), create);
   }
-  // A key of two values: the offsets of a two-difference spatial TV term.
-  ceres::CostFunction* Get(Family family, double value, double second_value,
-                           const std::vector<int>& shape,
-                           const std::function<ceres::CostFunction*()>& create) {
-    Key key(family, value, second_value, shape);
-    const auto it = cache_.find(key);
-    if (it != cache_.end()) return it->second;
-    owned_->emplace_back(create());
-    cache_.emplace(std::move(key), owned_->back().get());
-    return owned_->back().get();
+  // An event frame's: its value and number of steps.
+  template <typename Create>
+  ceres::CostFunction* GetSteps(Family family, double value, int steps, const Create& create) {
+    return Find(family, value, 0.0, &steps, 1, create);
+  }
+  // A key of two values and no shape: the offsets of a spatial TV term.
+  template <typename Create>
+  ceres::CostFunction* GetPair(Family family, double value, double second_value,
+                               const Create& create) {
+    return Find(family, value, second_value, nullptr, 0, create);
   }
 
  private:
-  using Key = std::tuple<Family, double, double, std::vector<int>>;
+  struct Entry {
+    Family family;
+    double value;
+    double second_value;
+    std::vector<int> shape;
+    ceres::CostFunction* cost;
+  };
+
+  template <typename Create>
+  ceres::CostFunction* Find(Family family, double value, double second_value, const int* shape,
+                            size_t shape_size, const Create& create) {
+    // -0.0 and 0.0 compare equal, so they are one key: both hash as 0.0.
+    value += 0.0;
+    second_value += 0.0;
+    const uint64_t hash = Hash(family, value, second_value, shape, shape_size);
+    const auto [begin, end] = cache_.equal_range(hash);
+    for (auto it = begin; it != end; ++it) {
+      const Entry& entry = it->second;
+      if (entry.family == family && entry.value == value && entry.second_value == second_value &&
+          entry.shape.size() == shape_size &&
+          std::equal(shape, shape + shape_size, entry.shape.begin())) {
+        return entry.cost;
+      }
+    }
+    owned_->emplace_back(create());
+    cache_.emplace(hash, Entry{family, value, second_value,
+                               std::vector<int>(shape, shape + shape_size), owned_->back().get()});
+    return owned_->back().get();
+  }
+
+  static uint64_t Hash(Family family, double value, double second_value, const int* shape,
+                       size_t shape_size) {
+    // FNV-1a over the key's words.
+    uint64_t hash = 14695981039346656037ull;
+    const auto mix = [&hash](uint64_t word) {
+      hash ^= word;
+      hash *= 1099511628211ull;
+    };
+    uint64_t bits = 0;
+    mix(static_cast<uint64_t>(family));
+    std::memcpy(&bits, &value, sizeof(bits));
+    mix(bits);
+    std::memcpy(&bits, &second_value, sizeof(bits));
+    mix(bits);
+    for (size_t i = 0; i < shape_size; ++i) mix(static_cast<uint64_t>(shape[i]));
+    return hash;
+  }
+
   std::vector<std::unique_ptr<ceres::CostFunction>>* owned_;
-  std::map<Key, ceres::CostFunction*> cache_;
+  std::unordered_multimap<uint64_t, Entry> cache_;
 };
 
 // One loss per term family and multiplicity: a residual standing for m identical terms (a spatial
@@ -366,7 +417,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
         // An unfired pixel's change has no event residual (LatentLayout).
         if (layout.segment(layout.segment_at(span.latent_last, p)).unfired_change) continue;
         const double value = values[p];
-        ceres::CostFunction* cost = cache.Get(Family::kEvent, value, {steps}, [&] {
+        ceres::CostFunction* cost = cache.GetSteps(Family::kEvent, value, steps, [&] {
           return EventResidual::Create(value, steps, objective.event_model);
         });
         if (steps == 1) {
@@ -390,7 +441,7 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
     // A difference's cost from its offset o_x (anisotropic), or a three-point term's from its
     // (o_x, o_y).
     const auto spatial_cost = [&](double offset_x, double offset_y) {
-      return cache.Get(Family::kSpatialTv, offset_x, offset_y, {}, [&]() -> ceres::CostFunction* {
+      return cache.GetPair(Family::kSpatialTv, offset_x, offset_y, [&]() -> ceres::CostFunction* {
         if (anisotropic) return DifferenceResidual::Create(offset_x);
         return objective.spatial_tv == SpatialTv::kIsotropic
                    ? IsotropicTvResidual::Create(offset_x, offset_y)
@@ -442,12 +493,12 @@ std::unique_ptr<BuiltProblem> ProblemBuilder::BuildUnit(const ProblemPlan& prepa
     // Σ_t |H_{t+1}(p) - H_t(p)| is the sum over the pixel's segment boundaries.
     ceres::LossFunction* loss = losses.Get(terms.weight(TermFamily::kTemporalTv), 1);
     ceres::CostFunction* linear =
-        cache.Get(Family::kTemporalTv, 0.0, {}, [] { return DifferenceResidual::Create(); });
+        cache.GetPair(Family::kTemporalTv, 0.0, 0.0, [] { return DifferenceResidual::Create(); });
     for (const int64_t p : pixels) {
       if (!inside(p)) continue;
       ceres::CostFunction* difference = linear;
       if (terms.temporal_tv_in_g_at(p)) {
-        difference = cache.Get(Family::kTemporalTv, 1.0, {}, [&] {
+        difference = cache.GetPair(Family::kTemporalTv, 1.0, 0.0, [&] {
           return TransformedDifferenceResidual::Create(objective.event_model);
         });
         ++statistics.log_temporal_tv_pixels;

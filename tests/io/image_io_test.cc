@@ -4,6 +4,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -57,6 +59,23 @@ TEST(ImageIoTest, ValuesAreClampedAndRounded) {
   EXPECT_EQ(read(0, 0), 0.0);
   EXPECT_NEAR(read(0, 1), 0.3, kHalf16BitLevel);
   EXPECT_EQ(read(0, 2), 1.0);
+}
+
+TEST(ImageIoTest, IntensityLevelRoundsAsLroundDoes) {
+  // Every half level of both depths (where rounding rules differ), and values between them.
+  for (const double max_level : {255.0, 65535.0}) {
+    for (int64_t twice = 0; twice <= 2 * static_cast<int64_t>(max_level); ++twice) {
+      for (const double nudge : {0.0, -1e-9, 1e-9}) {
+        const double value = (static_cast<double>(twice) / 2.0 + nudge) / max_level;
+        const double clamped = std::min(1.0, std::max(0.0, value));
+        ASSERT_EQ(IntensityLevel(value, max_level), std::lround(clamped * max_level))
+            << "value " << value << " at " << max_level;
+      }
+    }
+  }
+  EXPECT_EQ(IntensityLevel(-0.25, 255.0), 0);
+  EXPECT_EQ(IntensityLevel(1.5, 255.0), 255);
+  EXPECT_EQ(IntensityLevel(std::nan(""), 65535.0), 0);
 }
 
 TEST(ImageIoTest, ColourIsConvertedToGrey) {
