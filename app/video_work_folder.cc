@@ -36,7 +36,8 @@ bool DigitsThen(std::string_view name, std::string_view suffix) {
 }
 
 // Whether `relative` (inside a work folder, '/'-separated) is a path a video run writes there:
-// the marker, frames/, confidence/ and windows/ with their files, and each file's temporary name.
+// the marker, frames/, confidence/ and windows/ with their files, and each file's temporary name
+// (frames are written in place now; NNNNNN.tmp.png is what an interrupted earlier version left).
 bool IsWorkFolderPath(const std::string& relative, bool is_folder) {
   if (is_folder) return relative == "frames" || relative == "confidence" || relative == "windows";
   std::string_view name = relative;

@@ -41,8 +41,9 @@ cv::Mat ToMat(const Image& image, int type, double max_value) {
   cv::Mat mat(static_cast<int>(image.rows()), static_cast<int>(image.cols()), type);
   for (int y = 0; y < mat.rows; ++y) {
     Pixel* row = mat.ptr<Pixel>(y);
-    for (int x = 0; x < mat.cols; ++x)
+    for (int x = 0; x < mat.cols; ++x) {
       row[x] = static_cast<Pixel>(IntensityLevel(image(y, x), max_value));
+    }
   }
   return mat;
 }
