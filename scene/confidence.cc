@@ -15,18 +15,19 @@ namespace evfs {
 namespace {
 
 // What the events leave out, as factors of the model's terms. They were chosen on the 17 windows
-// of the shared data with a truth, the real DAVIS windows first, and are not derived
-// (docs/model.md, "A confidence for every output pixel"; BENCHMARKS.md, "Real recordings").
+// of the shared data with a truth, the real DAVIS windows first, and on the realistic variants;
+// they are not derived (docs/model.md, "A confidence for every output pixel"; BENCHMARKS.md,
+// "Real recordings").
 //  * A change the events drove is uncertain by a share of itself: the events' threshold and the
 //    response's offset are not known exactly. Measured as the estimate's departure from the
 //    observed frame (prediction) or from the frames' blend (between two sharp frames, where the
 //    second frame bounds it), at the pixels that fired.
-constexpr double kPredictionChangeFactor = 0.5;
+constexpr double kPredictionChangeFactor = 0.2;
 constexpr double kBridgeChangeFactor = 0.25;
 //  * Between two sharp frames, a pixel that fired errs by more than the pooled gap of the pair
 //    (one sample of its walk, shared with quiet neighbours) says; a quiet pixel changed by less
 //    than a threshold, smoothly, and the solve follows its own gap most of the way.
-constexpr double kBridgeEventGapFactor = 4.0;
+constexpr double kBridgeEventGapFactor = 2.0;
 constexpr double kQuietGapFactor = 0.35;
 //  * Each frame's noise counts once for the truth and once for the observations the estimate
 //    carries; between two frames those are two frames' worth, read from one estimate.
@@ -34,6 +35,12 @@ constexpr double kBridgeNoiseFactor = 1.5;
 //  * Where the scene moved, the change since a pixel's last crossing, under one threshold: half
 //    of what a change uniform over the threshold would leave (C² / 12 in g).
 constexpr double kUnrecordedFactor = 0.5;
+//  * After an observation, a pixel that fired no event may still have changed by up to a
+//    threshold: by its own gradient times how far the scene around it moved (UnrecordedChange).
+//    The variance is this share of that change squared.
+constexpr double kQuietUnrecordedFactor = 0.35;
+// Half-width in pixels of the square over which UnrecordedChange measures the motion.
+constexpr int kMotionRadiusPx = 7;
 
 // An observed frame where the latent video is pinned: a sharp frame at its latent frame, or a
 // blurred one at the middle of its exposure.
@@ -42,6 +49,14 @@ struct Anchor {
   const Image* image = nullptr;
   bool sharp = true;
 };
+
+// The observation nearest to latent frame t among the anchors at or before it (`before`) and
+// after it (`after`), either -1 when there is none.
+const Anchor& NearestAnchor(const std::vector<Anchor>& anchors, int before, int after, int t) {
+  if (before < 0) return anchors[after];
+  if (after < 0) return anchors[before];
+  return t - anchors[before].latent <= anchors[after].latent - t ? anchors[before] : anchors[after];
+}
 
 // The mean of `values` (rows × cols) over the (2 radius + 1)² square around each pixel, the
 // border reflected.
@@ -52,6 +67,40 @@ std::vector<float> BoxMean(const std::vector<float>& values, int rows, int cols,
   const int size = 2 * radius + 1;
   cv::blur(in, out, cv::Size(size, size), cv::Point(-1, -1), cv::BORDER_REFLECT);
   return mean;
+}
+
+// The change, in thresholds and at most 1, that each pixel of `estimate` (rows × cols) may have
+// undergone since the observation without firing: its gradient |∇g| (g = log(I + b), in
+// thresholds per pixel) times how far the scene around it moved, read as the events there per
+// unit of gradient (an edge of contrast k thresholds crossing a pixel fires k events):
+// r = |∇g| · mean(n) / mean(|∇g|) over the (2 kMotionRadiusPx + 1)² square around the pixel, n
+// the events of each pixel since the observation. 0 where nothing around it fired.
+std::vector<float> UnrecordedChange(const double* estimate, const std::vector<float>& events,
+                                    int rows, int cols, double b, double threshold) {
+  cv::Mat g(rows, cols, CV_64F);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      g.at<double>(r, c) = std::log(std::max(estimate[static_cast<size_t>(r) * cols + c], 0.0) + b);
+    }
+  }
+  cv::Mat dx, dy;
+  cv::Sobel(g, dx, CV_64F, 1, 0, 3, 1.0 / 8.0);
+  cv::Sobel(g, dy, CV_64F, 0, 1, 3, 1.0 / 8.0);
+  std::vector<float> gradient(events.size());
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      gradient[static_cast<size_t>(r) * cols + c] =
+          static_cast<float>(std::hypot(dx.at<double>(r, c), dy.at<double>(r, c)) / threshold);
+    }
+  }
+  const std::vector<float> mean_events = BoxMean(events, rows, cols, kMotionRadiusPx);
+  const std::vector<float> mean_gradient = BoxMean(gradient, rows, cols, kMotionRadiusPx);
+  std::vector<float> change(events.size(), 0.0f);
+  for (size_t p = 0; p < change.size(); ++p) {
+    if (mean_events[p] <= 0.0f || mean_gradient[p] <= 0.0f) continue;
+    change[p] = std::min(1.0f, gradient[p] * mean_events[p] / mean_gradient[p]);
+  }
+  return change;
 }
 
 // The frames' temporal noise, measured where the scene holds still: between two sharp frames,
@@ -238,6 +287,18 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
       time_fraction =
           span > 0.0 ? (static_cast<double>(latent.timestamp_ns(t)) - start) / span : 0.0;
     }
+    // After an observation (prediction, blurred exposures): the change each quiet pixel may have
+    // undergone unrecorded, from the events since the observation nearest to t.
+    const Anchor* observed = nullptr;
+    std::vector<float> unrecorded;
+    if (!bridge) {
+      observed = &NearestAnchor(anchors, before, after, t);
+      std::vector<float> since(pixels);
+      for (size_t p = 0; p < pixels; ++p) {
+        since[p] = static_cast<float>(std::abs(at(n, t, p) - at(n, observed->latent, p)));
+      }
+      unrecorded = UnrecordedChange(estimate, since, rows, cols, b, on);
+    }
     for (size_t p = 0; p < pixels; ++p) {
       double variance = 0.0;
       if (bridge) {
@@ -257,24 +318,25 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
           variance = kQuietGapFactor * own_gap[before][p] * s * (1.0 - s) + frames_noise;
         }
       } else {
-        const Anchor& observed =
-            before < 0 ? anchors[after]
-            : after < 0
-                ? anchors[before]
-                : (t - anchors[before].latent <= anchors[after].latent - t ? anchors[before]
-                                                                           : anchors[after]);
-        const int nearest = observed.latent;
+        const int nearest = observed->latent;
         const double events = std::abs(at(n, t, p) - at(n, nearest, p));
         const double one_event = (std::max(estimate[p], 0.0) + b) * options.threshold_spread;
         const double v = per_event >= 0.0 ? per_event : one_event * one_event;
-        // What the events have not recorded: away from the observation, where the scene moved,
-        // the change since the pixel's last crossing, under one threshold and taken as uniform
-        // over it (variance C² / 12 in g).
+        // What the events have not recorded: at a pixel that fired, away from the observation,
+        // the change since its last crossing, under one threshold and taken as uniform over it
+        // (variance C² / 12 in g); at a pixel that did not, the change its gradient and the
+        // motion around it suggest (UnrecordedChange).
         const double threshold = (std::max(estimate[p], 0.0) + b) * on;
-        const double residual = t != nearest && moved[p] > 0.0f
-                                    ? kUnrecordedFactor * threshold * threshold / 12.0
-                                    : 0.0;
-        const double change = events > 0.0 ? estimate[p] - observed.image->data()[p] : 0.0;
+        double residual = 0.0;
+        if (events > 0.0) {
+          if (t != nearest && moved[p] > 0.0f) {
+            residual = kUnrecordedFactor * threshold * threshold / 12.0;
+          }
+        } else {
+          const double quiet_change = unrecorded[p] * threshold;
+          residual = kQuietUnrecordedFactor * quiet_change * quiet_change;
+        }
+        const double change = events > 0.0 ? estimate[p] - observed->image->data()[p] : 0.0;
         variance =
             v * events + residual + kPredictionChangeFactor * change * change + 2.0 * noise * noise;
       }

@@ -14,7 +14,9 @@
 //    end: the variance grows with the events since the nearest observation, n · v, v the
 //    per-event variance the scene's pairs of sharp frames measured (Σ D² / Σ (n + 1)), or the
 //    caller's prior, or the threshold's spread ((I + b) · σ_C)² when nothing measured it; at a
-//    pixel that fired, plus a share of the change the events drove since the observation.
+//    pixel that fired, plus a share of the change the events drove since the observation; at a
+//    pixel that did not, a share of the change under one threshold that its gradient and the
+//    motion around it (the events nearby per unit of gradient) suggest.
 //  * The frames' own noise, the smaller of what the difference of two sharp frames shows where
 //    the scene holds still and NoiseSigma's single-frame estimate, both without clipped pixels
 //    (IsClippedLevel): once for the frame the output is compared with and once for the

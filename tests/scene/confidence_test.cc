@@ -56,7 +56,7 @@ Video Blend(const Scene& scene, double first, double second, double offset = 0.0
 
 // Where the events predict the second frame exactly, nothing is uncertain; where they miss it by
 // D, the error of a pixel that fired, between its two events (half of them behind, half ahead),
-// is |D| (4 · D² · s(1 − s) at s = 1/2), and zero at the frames (noise-free flat frames). An
+// is |D| / √2 (2 · D² · s(1 − s) at s = 1/2), and zero at the frames (noise-free flat frames). An
 // estimate that departs from the frames' blend by δ adds (δ / 2)².
 TEST(Confidence, BridgeBetweenSharpFramesGrowsWithTheFramesGap) {
   ConfidenceOptions options;  // Δg 0.2, b 0.5
@@ -71,13 +71,13 @@ TEST(Confidence, BridgeBetweenSharpFramesGrowsWithTheFramesGap) {
     EXPECT_NEAR(model.measured_event_variance, gap * gap * 64 / (64 * 3), kTolerance);
     EXPECT_EQ(model.frame_noise_sigma, 0.0);
     const int middle = sigma.NearestFrame(kWindowNs / 2);
-    EXPECT_NEAR(sigma.at(middle, 4, 4), gap, kTolerance) << second;
+    EXPECT_NEAR(sigma.at(middle, 4, 4), gap / std::sqrt(2.0), kTolerance) << second;
     EXPECT_NEAR(sigma.at(0, 4, 4), 0.0, kTolerance);
     EXPECT_NEAR(sigma.at(sigma.num_frames() - 1, 4, 4), 0.0, kTolerance);
     const double departure = 0.1;
     EXPECT_NEAR(
         PredictErrorSigma(scene, Blend(scene, 0.3, second, departure), options).at(middle, 4, 4),
-        std::sqrt(gap * gap + departure * departure / 4), kTolerance);
+        std::sqrt(gap * gap / 2 + departure * departure / 4), kTolerance);
   }
 }
 
@@ -113,7 +113,7 @@ TEST(Confidence, AQuietPixelBetweenSharpFramesFollowsItsOwnGap) {
 // After a single frame nothing measures the events: each one may be wrong by the threshold's
 // spread, ((I + b) · σ_C), and the errors add as a random walk; a prior per-event variance
 // replaces it. Away from the frame, where the scene moved, the change not yet recorded adds
-// half of ((I + b) · Δg)² / 12, and an estimate that departs from the frame by δ adds δ² / 2.
+// half of ((I + b) · Δg)² / 12, and an estimate that departs from the frame by δ adds δ² / 5.
 TEST(Confidence, PredictionGrowsWithTheEventsSinceTheFrame) {
   const Scene scene =
       MakePredictionScene(Flat(0.3, 0), kWindowNs, TwoOnEventsEverywhere(), BinningOptions());
@@ -134,9 +134,52 @@ TEST(Confidence, PredictionGrowsWithTheEventsSinceTheFrame) {
   departed.frame(0).setConstant(0.3);
   const Video wider = PredictErrorSigma(scene, departed, options);
   const double unrecorded_at_04 = 0.5 * 0.9 * 0.2 * 0.9 * 0.2 / 12.0;
-  EXPECT_NEAR(wider.at(last, 2, 2), std::sqrt(2 * 0.01 + unrecorded_at_04 + 0.1 * 0.1 / 2),
+  EXPECT_NEAR(wider.at(last, 2, 2), std::sqrt(2 * 0.01 + unrecorded_at_04 + 0.1 * 0.1 / 5),
               kTolerance);
   EXPECT_NEAR(wider.at(0, 2, 2), 0.0, kTolerance);
+}
+
+// After a frame, a pixel that fired no event may still have changed, by less than a threshold:
+// by its gradient times how far the scene around it moved (the events nearby per unit of
+// gradient), at most one threshold (I + b) · Δg, of which the band takes 0.35 of the square. On
+// a flat estimate, or where nothing around it fired, there is nothing for it to have changed by.
+TEST(Confidence, AQuietPixelAfterAFrameMayHaveChangedWithTheMotionAroundIt) {
+  // A ramp of g = log(I + b) along x, 0.1 per pixel: half a threshold.
+  Image ramp(kSize, kSize);
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) ramp(y, x) = std::exp(std::log(0.2 + 0.5) + 0.1 * x) - 0.5;
+  }
+  TimedFrame frame = Flat(0.0, 0);
+  frame.image = ramp;
+  const EventStream everywhere = TwoOnEventsEverywhere();
+  EventStream around(kSize, kSize);
+  for (size_t i = 0; i < everywhere.size(); ++i) {
+    if (everywhere.x(i) == 4 && everywhere.y(i) == 4) continue;
+    around.push_back(everywhere.t_ns(i), everywhere.x(i), everywhere.y(i), everywhere.polarity(i));
+  }
+  const auto sigma_at_quiet_pixel = [&](const EventStream& events, const Image& estimate,
+                                        double* noise) {
+    const Scene scene = MakePredictionScene(frame, kWindowNs, events, BinningOptions());
+    Video video = Constant(scene, 0.0);
+    for (int t = 0; t < video.num_frames(); ++t) video.frame(t) = estimate;
+    ConfidenceModel model;
+    const Video sigma = PredictErrorSigma(scene, video, ConfidenceOptions(), &model);
+    *noise = model.frame_noise_sigma;
+    EXPECT_NEAR(sigma.at(0, 4, 4), std::sqrt(2.0) * model.frame_noise_sigma, kTolerance);
+    return sigma.at(sigma.num_frames() - 1, 4, 4);
+  };
+  double noise = 0.0;
+  // Its neighbours fired two events each on a gradient of half a threshold per pixel: about
+  // four pixels of motion, two thresholds at this pixel's gradient, taken as one.
+  const double threshold = (ramp(4, 4) + 0.5) * 0.2;
+  EXPECT_NEAR(sigma_at_quiet_pixel(around, ramp, &noise),
+              std::sqrt(0.35 * threshold * threshold + 2.0 * noise * noise), kTolerance);
+  EXPECT_GT(threshold * threshold, 10 * noise * noise);
+  // On a flat estimate, and where no event fired, only the frame's noise is left.
+  EXPECT_NEAR(sigma_at_quiet_pixel(around, Image::Constant(kSize, kSize, 0.2), &noise),
+              std::sqrt(2.0) * noise, kTolerance);
+  EXPECT_NEAR(sigma_at_quiet_pixel(EventStream(kSize, kSize), ramp, &noise), std::sqrt(2.0) * noise,
+              kTolerance);
 }
 
 // Where no pixel of a 3x3 neighbourhood fired between two sharp frames, their difference is
