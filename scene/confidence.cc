@@ -32,8 +32,9 @@ constexpr double kQuietGapFactor = 0.35;
 //  * Each frame's noise counts once for the truth and once for the observations the estimate
 //    carries; between two frames those are two frames' worth, read from one estimate.
 constexpr double kBridgeNoiseFactor = 1.5;
-//  * Where the scene moved, the change since a pixel's last crossing, under one threshold: half
-//    of what a change uniform over the threshold would leave (C² / 12 in g).
+//  * After an observation, at a pixel that fired since, the change since its last crossing,
+//    under one threshold: half of what a change uniform over the threshold would leave (C² / 12
+//    in g).
 constexpr double kUnrecordedFactor = 0.5;
 //  * After an observation, a pixel that fired no event may still have changed by up to a
 //    threshold: by its own gradient times how far the scene around it moved (UnrecordedChange).
@@ -260,13 +261,6 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
   const double measured = sum_events > 0.0 ? sum_gap2 / sum_events : -1.0;
   const double per_event = measured >= 0.0 ? measured : options.prior_event_variance;
 
-  // Pixels where the scene moved over the window: they or a neighbour fired an event.
-  std::vector<float> fired(pixels);
-  for (size_t p = 0; p < pixels; ++p) {
-    fired[p] = at(n, frames - 1, p) > 0.0 ? 1.0f : 0.0f;
-  }
-  const std::vector<float> moved = BoxMean(fired, rows, cols, 1);
-
   Video sigma(rows, cols, frames);
   for (int t = 0; t < frames; ++t) {
     sigma.set_timestamp_ns(t, latent.timestamp_ns(t));
@@ -322,20 +316,14 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
         const double events = std::abs(at(n, t, p) - at(n, nearest, p));
         const double one_event = (std::max(estimate[p], 0.0) + b) * options.threshold_spread;
         const double v = per_event >= 0.0 ? per_event : one_event * one_event;
-        // What the events have not recorded: at a pixel that fired, away from the observation,
-        // the change since its last crossing, under one threshold and taken as uniform over it
+        // What the events have not recorded: at a pixel that fired since the observation, the
+        // change since its last crossing, under one threshold and taken as uniform over it
         // (variance C² / 12 in g); at a pixel that did not, the change its gradient and the
         // motion around it suggest (UnrecordedChange).
         const double threshold = (std::max(estimate[p], 0.0) + b) * on;
-        double residual = 0.0;
-        if (events > 0.0) {
-          if (t != nearest && moved[p] > 0.0f) {
-            residual = kUnrecordedFactor * threshold * threshold / 12.0;
-          }
-        } else {
-          const double quiet_change = unrecorded[p] * threshold;
-          residual = kQuietUnrecordedFactor * quiet_change * quiet_change;
-        }
+        const double quiet_change = unrecorded[p] * threshold;
+        const double residual = events > 0.0 ? kUnrecordedFactor * threshold * threshold / 12.0
+                                             : kQuietUnrecordedFactor * quiet_change * quiet_change;
         const double change = events > 0.0 ? estimate[p] - observed->image->data()[p] : 0.0;
         variance =
             v * events + residual + kPredictionChangeFactor * change * change + 2.0 * noise * noise;
