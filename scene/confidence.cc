@@ -29,9 +29,6 @@ constexpr double kBridgeChangeFactor = 0.25;
 //    than a threshold, smoothly, and the solve follows its own gap most of the way.
 constexpr double kBridgeEventGapFactor = 2.0;
 constexpr double kQuietGapFactor = 0.35;
-//  * Each frame's noise counts once for the truth and once for the observations the estimate
-//    carries; between two frames those are two frames' worth, read from one estimate.
-constexpr double kBridgeNoiseFactor = 1.5;
 //  * After an observation, at a pixel that fired since, the change since its last crossing,
 //    under one threshold: half of what a change uniform over the threshold would leave (C² / 12
 //    in g).
@@ -104,24 +101,52 @@ std::vector<float> UnrecordedChange(const double* estimate, const std::vector<fl
   return change;
 }
 
+// The noise sigma, in units of the quantisation step, of two frames whose quantised difference is
+// zero (after the shift common to all pixels) at a share `zeros` of the still pixels. With each
+// frame's noise N(0, σ²) and the scene's level uniform within a step, a continuous difference u
+// rounds to zero with probability max(0, 1 − |u|), so with u ~ N(0, τ²), τ = √2 σ,
+//   P(0) = erf(1 / (√2 τ)) − 2 τ (φ(0) − φ(1 / τ)),
+// which falls from 1 at τ = 0; solved for τ by bisection. Unlike the median absolute difference
+// it resolves noise below one step, where most differences are 0 or ±1.
+double NoiseFromZeroShare(double zeros) {
+  const auto phi = [](double v) { return std::exp(-0.5 * v * v) / std::sqrt(2.0 * M_PI); };
+  const auto zero_share = [&phi](double tau) {
+    return std::erf(1.0 / (std::sqrt(2.0) * tau)) - 2.0 * tau * (phi(0.0) - phi(1.0 / tau));
+  };
+  double low = 0.0, high = 1e3;
+  for (int i = 0; i < 100; ++i) {
+    const double tau = 0.5 * (low + high);
+    (tau > 0.0 && zero_share(tau) > zeros ? low : high) = tau;
+  }
+  return 0.5 * (low + high) / std::sqrt(2.0);
+}
+
 // The frames' temporal noise, measured where the scene holds still: between two sharp frames,
 // a pixel none of whose 3×3 neighbours fired an event saw no change above a threshold, so the
-// difference of its two frames is mostly their noise (variance 2σ²). The estimate is the robust
-// one, 1.4826 · median |d − median d| / √2 over every such pixel d = F_b − F_a of every pair.
-// Unlike a single frame's estimate it does not read texture or fixed-pattern noise, which the
-// reconstruction carries from the frames and the truth shares. A pixel clipped in either frame
-// (IsClippedLevel) shows no noise and is left out, as from the single-frame estimate: under a
-// saturated region the still pixels would otherwise measure none, and every quiet pixel's band
-// would shrink to nothing. −1 when the scene has no pair of sharp frames or fewer than
-// kMinStillPixels still pixels.
+// difference of its two frames is mostly their noise (variance 2σ²). Robust estimates over every
+// such pixel d = F_b − F_a of every pair, about the median difference (a change of exposure or
+// gain between the frames shifts every difference alike and is not noise): for 8-bit frames,
+// from the share of differences that round to zero (NoiseFromZeroShare); otherwise
+// 1.4826 · median |d − median d| / √2, which for 8-bit frames reads one step wherever most
+// differences are 0 or ±1 however small the noise is. Unlike a single frame's estimate neither
+// reads texture or fixed-pattern noise, which the reconstruction carries from the frames and the
+// truth shares. A pixel clipped in either frame (IsClippedLevel) shows no noise and is left out,
+// as from the single-frame estimate: under a saturated region the still pixels would otherwise
+// measure none, and every quiet pixel's band would shrink to nothing. −1 when the scene has no
+// pair of sharp frames or fewer than kMinStillPixels still pixels.
 double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float>& counts,
                      size_t pixels, int rows, int cols) {
   constexpr size_t kMinStillPixels = 500;
   std::vector<float> differences;
+  double quantisation_step = -1.0;  // 1/255 when every frame compared is 8-bit, else 0
   for (size_t i = 0; i + 1 < anchors.size(); ++i) {
     const Anchor& first = anchors[i];
     const Anchor& second = anchors[i + 1];
     if (!first.sharp || !second.sharp || second.latent <= first.latent) continue;
+    for (const Anchor* frame : {&first, &second}) {
+      const double step = QuantisationStep(*frame->image);
+      quantisation_step = quantisation_step < 0.0 || quantisation_step == step ? step : 0.0;
+    }
     std::vector<uint8_t> fired(pixels, 0);
     for (size_t p = 0; p < pixels; ++p) {
       fired[p] = counts[static_cast<size_t>(second.latent) * pixels + p] !=
@@ -146,8 +171,6 @@ double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float
     }
   }
   if (differences.size() < kMinStillPixels) return -1.0;
-  // The median absolute deviation from the median difference: a change of exposure or gain
-  // between the frames shifts every difference alike and is not noise.
   const auto median = [](std::vector<float>* values) {
     auto middle = values->begin() + values->size() / 2;
     std::nth_element(values->begin(), middle, values->end());
@@ -155,6 +178,12 @@ double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float
   };
   const double shift = median(&differences);
   for (float& difference : differences) difference = std::abs(difference - shift);
+  if (quantisation_step > 0.0) {
+    const auto zeros = std::count_if(differences.begin(), differences.end(),
+                                     [&](float d) { return d < 0.5 * quantisation_step; });
+    return quantisation_step *
+           NoiseFromZeroShare(static_cast<double>(zeros) / static_cast<double>(differences.size()));
+  }
   return 1.4826 * median(&differences) / std::sqrt(2.0);
 }
 
@@ -300,8 +329,8 @@ Video PredictErrorSigma(const Scene& scene, const Video& latent, const Confidenc
         const double events = at(n, z, p) - at(n, a, p);
         const double s = events > 0.0 ? (at(n, t, p) - at(n, a, p)) / events
                                       : static_cast<double>(t - a) / (z - a);
-        const double frames_noise =
-            kBridgeNoiseFactor * noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
+        // The truth's noise, and the two frames' noise that the blend at s carries.
+        const double frames_noise = noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
         if (events > 0.0) {
           const double blend = (1.0 - time_fraction) * anchors[before].image->data()[p] +
                                time_fraction * anchors[after].image->data()[p];

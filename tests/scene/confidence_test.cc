@@ -44,6 +44,24 @@ Video Constant(const Scene& scene, double level) {
   return video;
 }
 
+// Reproducible standard normal samples: Box–Muller on a linear congruential generator, without
+// <random>'s implementation-defined distributions.
+class Gaussian {
+ public:
+  explicit Gaussian(uint64_t seed) : state_(seed) {}
+  double operator()() {
+    const double u = Uniform();
+    return std::sqrt(-2.0 * std::log(u)) * std::cos(6.283185307179586 * Uniform());
+  }
+
+ private:
+  double Uniform() {
+    state_ = state_ * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (static_cast<double>(state_ >> 11) + 0.5) / 9007199254740992.0;
+  }
+  uint64_t state_;
+};
+
 // The frames' blend on the scene's timeline, plus `offset` everywhere.
 Video Blend(const Scene& scene, double first, double second, double offset = 0.0) {
   Video video = Constant(scene, 0.0);
@@ -52,6 +70,24 @@ Video Blend(const Scene& scene, double first, double second, double offset = 0.0
     video.frame(t).setConstant((1.0 - w) * first + w * second + offset);
   }
   return video;
+}
+
+// Two frames a window apart and one event at (event_x, event_y), so that the frames' other pixels
+// are still: the confidence of an estimate at 0.5 throughout, and the model behind it.
+struct StillPair {
+  ConfidenceModel model;
+  Video sigma;
+};
+StillPair PredictOverStillPair(TimedFrame first, TimedFrame second, int event_x, int event_y) {
+  first.exposure_begin_ns = first.exposure_end_ns = 0;
+  second.exposure_begin_ns = second.exposure_end_ns = kWindowNs;
+  first.label = second.label = "still";
+  EventStream events(first.image.cols(), first.image.rows());
+  events.push_back(kWindowNs / 2, event_x, event_y, 1);
+  const Scene scene = MakeInterpolationScene(first, second, events, BinningOptions());
+  StillPair result;
+  result.sigma = PredictErrorSigma(scene, Constant(scene, 0.5), ConfidenceOptions(), &result.model);
+  return result;
 }
 
 // Where the events predict the second frame exactly, nothing is uncertain; where they miss it by
@@ -101,9 +137,10 @@ TEST(Confidence, AQuietPixelBetweenSharpFramesFollowsItsOwnGap) {
       PredictErrorSigma(scene, Blend(scene, 0.3, agreeing), ConfidenceOptions(), &model);
   const int middle = sigma.NearestFrame(kWindowNs / 2);
   const double s = static_cast<double>(sigma.timestamp_ns(middle)) / kWindowNs;
-  // The frames' noise (the one bright pixel reads as some) counts 1.5 times per frame carried.
+  // The frames' noise (the one bright pixel reads as some): the truth's, and the two frames'
+  // that the blend at s carries.
   const double noise = model.frame_noise_sigma;
-  const double frames_noise = 1.5 * noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
+  const double frames_noise = noise * noise * (1.0 + s * s + (1.0 - s) * (1.0 - s));
   EXPECT_NEAR(sigma.at(middle, 4, 4),
               std::sqrt(0.35 * quiet_gap * quiet_gap * s * (1.0 - s) + frames_noise), kTolerance);
   // The noise read is small beside the gap, so the gap's share is what the band shows.
@@ -191,16 +228,7 @@ TEST(Confidence, FrameNoiseIsMeasuredWhereTheSceneHoldsStill) {
   TimedFrame first, second;
   first.image = Image::Constant(kWide, kWide, 0.4);
   second.image = Image::Constant(kWide, kWide, 0.45);  // a brighter exposure, not noise
-  uint64_t state = 12345;
-  const auto gaussian = [&state]() {
-    // Box–Muller on a linear congruential generator: reproducible without <random>'s
-    // implementation-defined distributions.
-    const auto uniform = [&state]() {
-      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-      return (static_cast<double>(state >> 11) + 0.5) / 9007199254740992.0;
-    };
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(6.283185307179586 * uniform());
-  };
+  Gaussian gaussian(12345);
   for (int y = 0; y < kWide; ++y) {
     for (int x = 0; x < kWide; ++x) {
       // Texture both frames share (a fixed pattern) and the frames' own temporal noise.
@@ -209,14 +237,7 @@ TEST(Confidence, FrameNoiseIsMeasuredWhereTheSceneHoldsStill) {
       second.image(y, x) += texture + sigma_noise * gaussian();
     }
   }
-  first.exposure_begin_ns = first.exposure_end_ns = 0;
-  second.exposure_begin_ns = second.exposure_end_ns = kWindowNs;
-  first.label = second.label = "noisy";
-  EventStream events(kWide, kWide);
-  events.push_back(kWindowNs / 2, 10, 10, 1);  // one event: the still pixels are the others
-  const Scene scene = MakeInterpolationScene(first, second, events, BinningOptions());
-  ConfidenceModel model;
-  PredictErrorSigma(scene, Constant(scene, 0.5), ConfidenceOptions(), &model);
+  const ConfidenceModel model = PredictOverStillPair(first, second, 10, 10).model;
   EXPECT_NEAR(model.frame_noise_sigma, sigma_noise, 0.1 * sigma_noise);
   EXPECT_NE(model.description.find("measured where the scene holds still"), std::string::npos)
       << model.description;
@@ -228,14 +249,7 @@ TEST(Confidence, FrameNoiseIsMeasuredWhereTheSceneHoldsStill) {
 TEST(Confidence, ClippedPixelsDoNotHideTheFramesNoise) {
   constexpr int kWide = 64;
   const double sigma_noise = 0.01;
-  uint64_t state = 777;
-  const auto uniform = [&state]() {
-    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (static_cast<double>(state >> 11) + 0.5) / 9007199254740992.0;
-  };
-  const auto gaussian = [&uniform]() {
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(6.283185307179586 * uniform());
-  };
+  Gaussian gaussian(777);
   TimedFrame first, second;
   first.image = Image::Constant(kWide, kWide, 1.0);
   second.image = Image::Constant(kWide, kWide, 1.0);
@@ -249,19 +263,44 @@ TEST(Confidence, ClippedPixelsDoNotHideTheFramesNoise) {
       }
     }
   }
-  first.exposure_begin_ns = first.exposure_end_ns = 0;
-  second.exposure_begin_ns = second.exposure_end_ns = kWindowNs;
-  first.label = second.label = "clipped";
-  EventStream events(kWide, kWide);
-  events.push_back(kWindowNs / 2, 40, 40, 1);
-  const Scene scene = MakeInterpolationScene(first, second, events, BinningOptions());
-  ConfidenceModel model;
-  const Video sigma = PredictErrorSigma(scene, Blend(scene, 0.5, 0.5), ConfidenceOptions(), &model);
+  const StillPair pair = PredictOverStillPair(first, second, 40, 40);
+  const ConfidenceModel& model = pair.model;
   EXPECT_NEAR(model.frame_noise_sigma, sigma_noise, 0.15 * sigma_noise);
   EXPECT_NE(model.description.find("measured where the scene holds still"), std::string::npos)
       << model.description;
   // A quiet pixel of the white region between the frames: its band is the frames' noise, not 0.
-  EXPECT_GT(sigma.frame(sigma.num_frames() / 2)(30, 10), 0.5 * sigma_noise);
+  EXPECT_GT(pair.sigma.frame(pair.sigma.num_frames() / 2)(30, 10), 0.5 * sigma_noise);
+}
+
+// 8-bit frames whose noise is under one grey level: most still pixels differ by 0 or ±1 level,
+// so the median absolute difference reads one level (1.4826 / √2 ≈ 1.05 levels) whatever the
+// noise. The share of differences that round to zero resolves it. A uniform texture under the
+// noise, so that the scene's level falls anywhere within a step, and a brighter second exposure
+// by two levels, which is not noise.
+TEST(Confidence, EightBitFramesNoiseUnderOneLevelIsMeasuredFromTheDifferencesAtZero) {
+  constexpr int kWide = 96;
+  constexpr double kLevel = 1.0 / 255.0;
+  for (const double noise_levels : {0.3, 0.6, 1.5}) {
+    Gaussian gaussian(4242);
+    // The scene's level at each pixel: 60 to 160 grey levels, fractions spread evenly.
+    const auto recorded = [&](double exposure_shift) {
+      TimedFrame frame;
+      frame.image = Image::Constant(kWide, kWide, 0.0);
+      for (int p = 0; p < kWide * kWide; ++p) {
+        const double golden = p * 0.6180339887 - std::floor(p * 0.6180339887);
+        const double level = 60.0 + 100.0 * golden + exposure_shift;
+        frame.image(p / kWide, p % kWide) = std::round(level + noise_levels * gaussian()) * kLevel;
+      }
+      return frame;
+    };
+    const TimedFrame first = recorded(0.0);
+    const TimedFrame second = recorded(2.0);
+    const ConfidenceModel model = PredictOverStillPair(first, second, 10, 10).model;
+    EXPECT_NEAR(model.frame_noise_sigma, noise_levels * kLevel, 0.1 * noise_levels * kLevel)
+        << noise_levels << " levels";
+    EXPECT_NE(model.description.find("measured where the scene holds still"), std::string::npos)
+        << model.description;
+  }
 }
 
 TEST(Confidence, ShareWithinSigmaCountsThePixelsInsideTheBand) {
