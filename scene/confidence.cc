@@ -126,14 +126,14 @@ double NoiseFromZeroShare(double zeros) {
 // difference of its two frames is mostly their noise (variance 2σ²). Robust estimates over every
 // such pixel d = F_b − F_a of every pair, about the median difference (a change of exposure or
 // gain between the frames shifts every difference alike and is not noise): for 8-bit frames,
-// from the share of differences that round to zero (NoiseFromZeroShare); otherwise
-// 1.4826 · median |d − median d| / √2, which for 8-bit frames reads one step wherever most
-// differences are 0 or ±1 however small the noise is. Unlike a single frame's estimate neither
-// reads texture or fixed-pattern noise, which the reconstruction carries from the frames and the
-// truth shares. A pixel clipped in either frame (IsClippedLevel) shows no noise and is left out,
-// as from the single-frame estimate: under a saturated region the still pixels would otherwise
-// measure none, and every quiet pixel's band would shrink to nothing. −1 when the scene has no
-// pair of sharp frames or fewer than kMinStillPixels still pixels.
+// from the share of differences that round to zero (NoiseFromZeroShare) while that share is
+// large enough to count; otherwise 1.4826 · median |d − median d| / √2, which for 8-bit frames
+// reads one step wherever most differences are 0 or ±1 however small the noise is. Unlike a single
+// frame's estimate neither reads texture or fixed-pattern noise, which the reconstruction carries
+// from the frames and the truth shares. A pixel clipped in either frame (IsClippedLevel) shows no
+// noise and is left out, as from the single-frame estimate: under a saturated region the still
+// pixels would otherwise measure none, and every quiet pixel's band would shrink to nothing. −1
+// when the scene has no pair of sharp frames or fewer than kMinStillPixels still pixels.
 double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float>& counts,
                      size_t pixels, int rows, int cols) {
   constexpr size_t kMinStillPixels = 500;
@@ -178,11 +178,15 @@ double TemporalNoise(const std::vector<Anchor>& anchors, const std::vector<float
   };
   const double shift = median(&differences);
   for (float& difference : differences) difference = std::abs(difference - shift);
+  // Below this share of zeros (noise above about four steps) the steps no longer bias the median
+  // and too few zeros remain to count.
+  constexpr double kMinZeroShare = 0.1;
   if (quantisation_step > 0.0) {
-    const auto zeros = std::count_if(differences.begin(), differences.end(),
-                                     [&](float d) { return d < 0.5 * quantisation_step; });
-    return quantisation_step *
-           NoiseFromZeroShare(static_cast<double>(zeros) / static_cast<double>(differences.size()));
+    const double zeros =
+        static_cast<double>(std::count_if(differences.begin(), differences.end(),
+                                          [&](float d) { return d < 0.5 * quantisation_step; })) /
+        static_cast<double>(differences.size());
+    if (zeros >= kMinZeroShare) return quantisation_step * NoiseFromZeroShare(zeros);
   }
   return 1.4826 * median(&differences) / std::sqrt(2.0);
 }

@@ -274,13 +274,13 @@ TEST(Confidence, ClippedPixelsDoNotHideTheFramesNoise) {
 
 // 8-bit frames whose noise is under one grey level: most still pixels differ by 0 or ±1 level,
 // so the median absolute difference reads one level (1.4826 / √2 ≈ 1.05 levels) whatever the
-// noise. The share of differences that round to zero resolves it. A uniform texture under the
-// noise, so that the scene's level falls anywhere within a step, and a brighter second exposure
-// by two levels, which is not noise.
+// noise. The share of differences that round to zero resolves it; at 8 levels few differences
+// are zero and the median reads it. A uniform texture under the noise, so that the scene's level
+// falls anywhere within a step, and a brighter second exposure by two levels, which is not noise.
 TEST(Confidence, EightBitFramesNoiseUnderOneLevelIsMeasuredFromTheDifferencesAtZero) {
   constexpr int kWide = 96;
   constexpr double kLevel = 1.0 / 255.0;
-  for (const double noise_levels : {0.3, 0.6, 1.5}) {
+  for (const double noise_levels : {0.3, 0.6, 1.5, 8.0}) {
     Gaussian gaussian(4242);
     // The scene's level at each pixel: 60 to 160 grey levels, fractions spread evenly.
     const auto recorded = [&](double exposure_shift) {
