@@ -21,10 +21,7 @@ echo "|---|---|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
   prepare_clip "$clip"
   for variant in mains all; do
-    sim="$out/sim_${clip}_$variant"
-    # shellcheck disable=SC2046  # the flags are words
-    "$evfs" simulate --frames="$frames" --out="$sim" --overwrite \
-      $(variant_flags "$led_x" "$led_y" "$led_r" "$variant") >/dev/null
+    simulate_variant "$clip" "$variant"
     for window in "predict 0 8" "interpolate 0 16"; do
       read -r mode first last <<< "$window"
       for reversals in 3 0; do

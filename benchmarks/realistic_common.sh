@@ -1,8 +1,10 @@
-# Sourced by benchmarks/realistic_variants.sh and realistic_video.sh.
+# Sourced by benchmarks/realistic_variants.sh, realistic_video.sh, variant_bands.sh, flicker_windows.sh
+# and saturation_variants.sh.
 #
 #   parse_arguments SCRIPT BUILD_DIR DATA_DIR OUT_DIR [CROP_PX] [CLIP...]
 #   prepare_clip CLIP [FRAMES]
 #   variant_flags LED_X LED_Y LED_RADIUS VARIANT
+#   simulate_variant CLIP VARIANT
 
 # Sets build, data, out (created), crop, clips (clips.txt's when none given), evfs and helper.
 parse_arguments() {
@@ -64,4 +66,12 @@ variant_flags() {
     exposure20ms) echo "$exposure" ;;
     all) echo "$hot $leak $led $mains $saturation $frame_noise $exposure" ;;
   esac
+}
+
+# Simulates VARIANT of CLIP (after prepare_clip CLIP) into $out/sim_CLIP_VARIANT and sets sim to it.
+simulate_variant() {
+  sim="$out/sim_$1_$2"
+  # shellcheck disable=SC2046  # the flags are words
+  "$evfs" simulate --frames="$frames" --out="$sim" --overwrite \
+    $(variant_flags "$led_x" "$led_y" "$led_r" "$2") >/dev/null
 }

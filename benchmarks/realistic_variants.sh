@@ -31,10 +31,7 @@ echo "|---|---|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
   prepare_clip "$clip"
   for variant in "${variants[@]}"; do
-    sim="$out/sim_${clip}_$variant"
-    # shellcheck disable=SC2046  # the flags are words
-    "$evfs" simulate --frames="$frames" --out="$sim" --overwrite \
-      $(variant_flags "$led_x" "$led_y" "$led_r" "$variant") >/dev/null
+    simulate_variant "$clip" "$variant"
     led=""
     case $variant in flicker_led | all) led="$led_x,$led_y,$led_r" ;; esac
     for entry in "${methods[@]}"; do

@@ -6,6 +6,7 @@ standard library only.
   realistic_variants_helper.py crop SOURCE TARGET SIDE NUM_FRAMES
   realistic_variants_helper.py camera SIMULATION TARGET STEP [SHARP_FRAMES]
   realistic_variants_helper.py score CLIP VARIANT METHOD RECONSTRUCTION CLEAN_FRAME LED
+  realistic_variants_helper.py saturation CLIP CLEAN_REC SATURATED_REC GAIN
 """
 import json, math, os, struct, sys, zlib
 
@@ -91,6 +92,43 @@ def score(clip, variant, method, reconstruction, clean_frame, led):
     print("| %s | %s | %s | %.2f | %.4f | %.2f | %s |"
           % (clip, variant, method, truth["psnr"], truth["ssim"], whole, away))
 
+def truth_and_estimate(reconstruction):
+    """The frame a reconstruction was scored against, its estimate there, and its recording."""
+    summary = json.load(open(os.path.join(reconstruction, "summary.json")))
+    truth = summary["truth"]
+    data = summary["data"]
+    lines = [l.split() for l in open(os.path.join(data, "images.txt")) if l.strip() and not l.startswith("#")]
+    estimate = read_png(os.path.join(reconstruction, "frames", "%06d.png" % truth["latent_index"]))
+    return read_png(os.path.join(data, lines[truth["index"]][1])), estimate, data, lines
+
+def saturation(clip, clean_rec, saturated_rec, gain):
+    """The clean clip against its variant with frame gain GAIN, away from where the variant
+    saturates: pixels of the variant's truth or of the frames the window observed at or above
+    0.99 (of 1), grown by 4 pixels, are left out. The variant's errors are divided by the gain
+    (its frames are GAIN times brighter, so the same relative error is GAIN times larger)."""
+    gain = float(gain)
+    clean_truth, clean_estimate, _, _ = truth_and_estimate(clean_rec)
+    truth, estimate, data, lines = truth_and_estimate(saturated_rec)
+    options = json.load(open(os.path.join(saturated_rec, "summary.json")))["options"]
+    observed = [read_png(os.path.join(data, lines[int(options[k])][1])) for k in ("first", "last")]
+    height, width = len(truth), len(truth[0])
+    saturated = [[any(img[y][x] >= 0.99 for img in [truth] + observed) for x in range(width)]
+                 for y in range(height)]
+    grow = 4
+    near = [[False] * width for _ in range(height)]
+    for y in range(height):
+        for x in range(width):
+            if saturated[y][x]:
+                for yy in range(max(0, y - grow), min(height, y + grow + 1)):
+                    for xx in range(max(0, x - grow), min(width, x + grow + 1)):
+                        near[yy][xx] = True
+    keep = lambda x, y: not near[y][x]
+    share = sum(row.count(True) for row in near) / float(width * height)
+    away_clean = psnr(clean_estimate, clean_truth, keep)
+    away_saturated = psnr(estimate, truth, keep) + 20 * math.log10(gain)
+    print("| %s | %.1f %% | %.2f | %.2f | %+.2f |" % (clip, 100 * share, away_clean, away_saturated,
+                                                    away_saturated - away_clean))
+
 def camera(simulation, target, step, sharp_frames=None):
     """The recording a slower frame camera makes of SIMULATION: every STEP-th frame (and its
     exposure), all of the events. With SHARP_FRAMES (the folder of the frames the simulation was
@@ -124,5 +162,7 @@ if __name__ == "__main__":
         crop(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]))
     elif sys.argv[1] == "camera":
         camera(sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5] if len(sys.argv) > 5 else None)
+    elif sys.argv[1] == "saturation":
+        saturation(*sys.argv[2:6])
     else:
         score(*sys.argv[2:8])

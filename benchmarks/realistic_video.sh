@@ -30,10 +30,7 @@ echo "|---|---|---|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
   prepare_clip "$clip" "$(grep -cv '^#' "$data/$clip/images.txt")"
   for variant in exposure20ms all; do
-    sim="$out/sim_${clip}_$variant"
-    # shellcheck disable=SC2046  # the flags are words
-    "$evfs" simulate --frames="$frames" --out="$sim" --overwrite \
-      $(variant_flags "$led_x" "$led_y" "$led_r" "$variant") >/dev/null
+    simulate_variant "$clip" "$variant"
     flags=$(variant_flags "$led_x" "$led_y" "$led_r" "$variant")
     sharp="$out/sharp_${clip}_$variant"
     # shellcheck disable=SC2086  # the flags are words

@@ -20,10 +20,7 @@ echo "|---|---|---|---|---|"
 for clip in "${clips[@]}"; do
   prepare_clip "$clip"
   for variant in clean hot frame_noise mains all; do
-    sim="$out/sim_${clip}_$variant"
-    # shellcheck disable=SC2046  # the flags are words
-    "$evfs" simulate --frames="$frames" --out="$sim" --overwrite \
-      $(variant_flags "$led_x" "$led_y" "$led_r" "$variant") >/dev/null
+    simulate_variant "$clip" "$variant"
     for window in "interpolate 0 16" "predict 0 8"; do
       read -r mode first last <<< "$window"
       rec="$out/rec_${clip}_${variant}_$mode"
