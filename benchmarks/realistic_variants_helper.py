@@ -93,13 +93,15 @@ def score(clip, variant, method, reconstruction, clean_frame, led):
           % (clip, variant, method, truth["psnr"], truth["ssim"], whole, away))
 
 def truth_and_estimate(reconstruction):
-    """The frame a reconstruction was scored against, its estimate there, and its recording."""
+    """The frame a reconstruction was scored against, its estimate there, its summary.json, and
+    a reader of its recording's frames by images.txt line."""
     summary = json.load(open(os.path.join(reconstruction, "summary.json")))
     truth = summary["truth"]
     data = summary["data"]
     lines = [l.split() for l in open(os.path.join(data, "images.txt")) if l.strip() and not l.startswith("#")]
+    frame = lambda index: read_png(os.path.join(data, lines[index][1]))
     estimate = read_png(os.path.join(reconstruction, "frames", "%06d.png" % truth["latent_index"]))
-    return read_png(os.path.join(data, lines[truth["index"]][1])), estimate, data, lines
+    return frame(truth["index"]), estimate, summary, frame
 
 def saturation(clip, clean_rec, saturated_rec, gain):
     """The clean clip against its variant with frame gain GAIN, away from where the variant
@@ -108,9 +110,8 @@ def saturation(clip, clean_rec, saturated_rec, gain):
     (its frames are GAIN times brighter, so the same relative error is GAIN times larger)."""
     gain = float(gain)
     clean_truth, clean_estimate, _, _ = truth_and_estimate(clean_rec)
-    truth, estimate, data, lines = truth_and_estimate(saturated_rec)
-    options = json.load(open(os.path.join(saturated_rec, "summary.json")))["options"]
-    observed = [read_png(os.path.join(data, lines[int(options[k])][1])) for k in ("first", "last")]
+    truth, estimate, summary, frame = truth_and_estimate(saturated_rec)
+    observed = [frame(int(summary["options"][k])) for k in ("first", "last")]
     height, width = len(truth), len(truth[0])
     saturated = [[any(img[y][x] >= 0.99 for img in [truth] + observed) for x in range(width)]
                  for y in range(height)]
