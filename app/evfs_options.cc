@@ -14,6 +14,7 @@
 #include "evfs/app/calibrate_job.h"
 #include "evfs/app/denoise_job.h"
 #include "evfs/app/initialization.h"
+#include "evfs/app/log_offset_search.h"
 #include "evfs/app/method.h"
 #include "evfs/core/enum_names.h"
 #include "evfs/core/error.h"
@@ -108,6 +109,13 @@ void SetSmoothingContinuation(const OptionValue& value, const std::string& flag,
                               EvfsSettings* settings) {
   settings->reconstruct.method.reconstruction.smoothing_continuation =
       ParseNumberList(std::get<std::string>(value), flag);
+}
+
+void SetLogOffsetSearch(const OptionValue& value, const std::string& flag, EvfsSettings* settings) {
+  settings->reconstruct.log_offset_search = ParseNumberList(std::get<std::string>(value), flag);
+  for (const double b : settings->reconstruct.log_offset_search) {
+    if (!(b > 0.0)) throw InvalidArgumentError(flag + " values must be > 0");
+  }
 }
 
 void SetLinearSolver(const OptionValue& value, const std::string& flag, EvfsSettings* settings) {
@@ -355,6 +363,16 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
           Double(ObjectiveOptions().event_model.log_offset, ValueRange::Above(0.0)),
           "b of the log event model.",
           EVFS_OPTION_FIELD(reconstruct.method.reconstruction.objective.event_model.log_offset)),
+      Row("log_offset_search", "model", "reconstruct video", kReconstructKey | kNumberList,
+          Text(kDefaultLogOffsetSearch),
+          "Comma-separated values of b tried for the windows between two frames (not when "
+          "--log_offset or a calibrated --event_model gives b): each reconstructs two frames of "
+          "the recording from their neighbours "
+          "(reconstruct: the nearest the window does not use, nor --truth; video: two of its "
+          "observed frames), and the best replaces --log_offset there; without three such frames, "
+          "or "
+          "empty: --log_offset.",
+          Custom("reconstruct.log_offset_search", SetLogOffsetSearch)),
       Row("spatial_tv", "model", "reconstruct video", kReconstructKey, Text("anisotropic"),
           "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | isotropic (sqrt(dx^2+dy^2)).",
           EVFS_OPTION_NAMED(reconstruct.method.reconstruction.objective.spatial_tv,
@@ -664,13 +682,18 @@ std::vector<std::string> Words(const std::string& text) {
   return words;
 }
 
-// Copies the thread count to every solver, resolves --denoise=auto and reads a calibrated
-// event model, as the options given say.
+// Copies the thread count to every solver, resolves --denoise=auto, reads a calibrated event
+// model and leaves a given b unsearched, as the options given say.
 void FinishReconstructRequest(const OptionValues& values, EvfsSettings* settings) {
   ReconstructRequest& request = settings->reconstruct;
   MethodOptions& method = request.method;
   method.adam.num_threads = method.reconstruction.solver.num_threads;
   method.lbfgs.num_threads = method.reconstruction.solver.num_threads;
+  // A b given, or read from a calibrated model, is not searched unless the search is asked for.
+  if ((values.Given("log_offset") || !settings->event_model_file.empty()) &&
+      !values.Given("log_offset_search")) {
+    request.log_offset_search.clear();
+  }
   if (!settings->event_model_file.empty()) {
     ReconstructionOptions& reconstruction = method.reconstruction;
     ApplyEventModelFile(settings->event_model_file, reconstruction.estimation,
@@ -830,6 +853,7 @@ VideoRequest VideoRequestFromOptions(const OptionValues& values) {
       values.Given("threads") ? reconstruct.method.reconstruction.solver.num_threads : 0;
   request.binning = reconstruct.binning;
   request.method = reconstruct.method;
+  request.log_offset_search = reconstruct.log_offset_search;
   request.denoise = reconstruct.denoise;
   request.settings = VideoFingerprint(values);
   return request;

@@ -25,6 +25,9 @@ using Clock = std::chrono::steady_clock;
 // Most frames --fps may resample the latent video to (a runaway rate would fill memory).
 constexpr double kMaxOutputFrames = 10000;
 
+// Frames outside the window ReconstructRequest::log_offset_search interpolates per candidate.
+constexpr int kLogOffsetSearchTriplets = 2;
+
 void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   const int count = static_cast<int>(source.frames().size());
   if (count == 0) {
@@ -254,6 +257,50 @@ void ScoreTruth(const Video& latent, const Video& baseline, const Video& sigma,
   *within_sigma = ShareWithinSigma(estimate, truth_image, sigma.frame(truth->latent_index));
 }
 
+// The request's method with b chosen by ReconstructRequest::log_offset_search: each candidate
+// interpolates frames outside the window (never the window's own withheld frames or the truth)
+// from their neighbours; see app/log_offset_search.h.
+MethodOptions SearchedMethod(const DataSource& source, const ReconstructRequest& request, int last,
+                             const SharpFrameTiming& timing, ReconstructResult* result) {
+  MethodOptions method = request.method;
+  EventModelParams& model = method.reconstruction.objective.event_model;
+  if (request.log_offset_search.empty() || request.mode != Mode::kInterpolate ||
+      !IsIterative(method.method) || model.model != EventModel::kLog) {
+    return method;
+  }
+  const auto start = Clock::now();
+  std::vector<int> excluded;
+  for (int i = request.first + 1; i < last; ++i) excluded.push_back(i);
+  if (request.truth >= 0) excluded.push_back(request.truth);
+  const int64_t middle_ns = (SharpFrameSpan(source, request.first, timing).middle_ns() +
+                             SharpFrameSpan(source, last, timing).middle_ns()) /
+                            2;
+  const std::vector<ValidationTriplet> triplets = ValidationTriplets(
+      static_cast<int>(source.frames().size()), excluded,
+      [&](int i) { return SharpFrameSpan(source, i, timing).middle_ns(); }, middle_ns,
+      kLogOffsetSearchTriplets);
+  // Each triplet's scene once, solved with every candidate.
+  std::vector<ValidationScene> scenes;
+  for (const ValidationTriplet& triplet : triplets) {
+    const TimedFrame first = ReadSharpFrame(source, triplet.first, timing);
+    const TimedFrame after = ReadSharpFrame(source, triplet.last, timing);
+    const int64_t begin = first.exposure_begin_ns, end = after.exposure_end_ns;
+    scenes.push_back(MakeValidationScene(first, after, source.ReadImage(triplet.middle),
+                                         SharpFrameSpan(source, triplet.middle, timing).middle_ns(),
+                                         source.ReadEvents(begin, end), begin, end, request.binning,
+                                         kValidationSquarePx));
+  }
+  const auto squared_error = [&](const ValidationTriplet& triplet, double b) {
+    return ValidationError(scenes[&triplet - triplets.data()], method, b);
+  };
+  result->log_offset_choice =
+      ChooseLogOffset(request.log_offset_search, triplets, model.log_offset, squared_error);
+  result->log_offset_searched = true;
+  result->log_offset_search_s = SecondsSince(start);
+  model.log_offset = result->log_offset_choice.chosen;
+  return method;
+}
+
 // The job, reading `given` or, when it is null, the recording at request.data_path: read →
 // frame timing → scene → solve → denoise → seams → output and confidence → score.
 ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
@@ -303,7 +350,8 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   }
   CheckMethodSupports(request.method.method, scene, "this case");
   stage(request.progress ? "build" : "build and solve");
-  MethodOptions method = request.method;
+  const MethodOptions chosen = SearchedMethod(source, request, last, timing, &result);
+  MethodOptions method = chosen;
   StartSolveClock(&method);
   result.run = RunMethod(scene, method, request.progress, request.checkpoints,
                          score ? &checkpoint_truth : nullptr);
@@ -311,18 +359,18 @@ ReconstructResult RunReconstructionFrom(const ReconstructRequest& request,
   result.time.solve_s = result.run.solve_time_s;
   if (denoiser != nullptr) {
     stage("denoise");
-    result.denoise = DenoiseSolution(*denoiser, request.denoise, scene, request.method, method,
+    result.denoise = DenoiseSolution(*denoiser, request.denoise, scene, chosen, method,
                                      score ? &truth_image : nullptr, result.truth.timestamp_ns,
                                      nullptr, &result.run);
   }
-  ApplySharpFrameSeams(scene, request.method, &result.run);
+  ApplySharpFrameSeams(scene, chosen, &result.run);
 
   // Made after the solve, so that the solve does not hold a third latent video.
   result.baseline = InitializeLatentVideo(scene);
   const Video& latent = result.run.video;
   result.output = request.fps > 0.0 ? Resample(latent, request.fps) : latent;
-  const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(request.method, result.run),
-                                        &result.confidence_model);
+  const Video sigma =
+      PredictErrorSigma(scene, latent, ConfidenceFor(chosen, result.run), &result.confidence_model);
   result.confidence = request.fps > 0.0 ? Resample(sigma, request.fps) : sigma;
   if (score) {
     result.truth.index = request.truth;
@@ -491,6 +539,11 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json["solver"] = std::move(solver);
   if (iterative) {
     json["model"] = ModelJson(options.objective, summary);
+    if (result.log_offset_searched) {
+      json["model"]["log_offset"] = Number(result.log_offset_choice.chosen);
+      json["model"]["log_offset_search"] =
+          LogOffsetChoiceJson(result.log_offset_choice, result.log_offset_search_s);
+    }
     json["solved"] = run.solved;
     json["iterations"] = run.iterations;
     json["initial_cost"] = Number(run.initial_cost);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "evfs/app/denoise_job.h"
+#include "evfs/app/log_offset_search.h"
 #include "evfs/app/method.h"
 #include "evfs/core/enum_names.h"
 #include "evfs/core/video.h"
@@ -53,6 +54,9 @@ struct ReconstructRequest {
   BinningOptions binning;
   /// The method and all its settings (objective.event_model.alpha <= 0: derive α from the data).
   MethodOptions method;
+  /// Interpolate with the log model: the values of b tried on frames outside the window
+  /// (app/log_offset_search.h); the best replaces the model's b. Empty: the model's b.
+  std::vector<double> log_offset_search;
   /// Record cost (and PSNR/SSIM against --truth) at every iteration into summary.json.
   bool checkpoints = false;
   /// The residual denoiser after the solve (DenoiseMode::kNone: none).
@@ -108,6 +112,10 @@ struct ReconstructResult {
   /// represents lies after its timestamp (the first frame's exposure middle for start, middle,
   /// end).
   FrameLagEstimate frame_lag;
+  /// What ReconstructRequest::log_offset_search chose (searched is false when it did not run).
+  bool log_offset_searched = false;
+  LogOffsetChoice log_offset_choice;
+  double log_offset_search_s = 0.0;  // its solves, before the window's
   int64_t frame_shift_ns = 0;
 };
 

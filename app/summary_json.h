@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "evfs/app/log_offset_search.h"
+
 namespace evfs {
 
 /// `value`, or null when it is not finite.
@@ -18,6 +20,9 @@ nlohmann::ordered_json Number(double value);
 /// a solve's parts and keeps the most passes any part made). Their count times one pass's cost
 /// is the floor the solve cannot go below without fewer passes.
 nlohmann::ordered_json CeresWorkJson(const ceres::Solver::Summary& summary);
+
+/// What a log offset search tried and chose (app/log_offset_search.h), and its time.
+nlohmann::ordered_json LogOffsetChoiceJson(const LogOffsetChoice& choice, double seconds);
 
 }  // namespace evfs
 

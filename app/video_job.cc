@@ -69,6 +69,8 @@ struct WindowContext {
   const SharedSource* source = nullptr;
   const OutputClock* clock = nullptr;
   MethodOptions method;  // with the per-window thread count
+  /// b of the interpolation windows (VideoRequest::log_offset_search); <= 0: method's.
+  double interpolation_log_offset = 0.0;
   const Denoiser* denoiser = nullptr;
   fs::path work;
 };
@@ -163,8 +165,13 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   const auto bin_start = Clock::now();
   const Scene scene = MakeScene(frames, events, window.begin_ns, window.end_ns, request.binning);
   const double bin_s = SecondsSince(bin_start);
-  CheckMethodSupports(context.method.method, scene, "window " + std::to_string(window.index));
-  MethodOptions method = context.method;  // --max_time_s bounds each window's solve
+  MethodOptions window_method = context.method;
+  if (window.kind == VideoWindowKind::kInterpolate && context.interpolation_log_offset > 0.0) {
+    window_method.reconstruction.objective.event_model.log_offset =
+        context.interpolation_log_offset;
+  }
+  CheckMethodSupports(window_method.method, scene, "window " + std::to_string(window.index));
+  MethodOptions method = window_method;  // --max_time_s bounds each window's solve
   StartSolveClock(&method);
   MethodResult run = RunMethod(scene, method, IterationCallback(), false, nullptr);
   // An interrupted window is not recorded: --resume solves it again.
@@ -179,11 +186,11 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     const auto denoise_start = Clock::now();
     const std::vector<uint8_t> frames_read =
         FramesTheOutputNeeds(window, scene, run.video, context, begin, end);
-    denoise_record = DenoiseSolution(*context.denoiser, request.denoise, scene, context.method,
+    denoise_record = DenoiseSolution(*context.denoiser, request.denoise, scene, window_method,
                                      method, nullptr, 0, &frames_read, &run);
     denoise_s = SecondsSince(denoise_start);
   }
-  ApplySharpFrameSeams(scene, context.method, &run);
+  ApplySharpFrameSeams(scene, window_method, &run);
   // A sharp observed frame is the output at its own time, unchanged.
   Video& latent = run.video;
   for (size_t k = 0; k < window.frames.size(); ++k) {
@@ -192,7 +199,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
     if (latent.timestamp_ns(at) == window.frames[k].t_ns) latent.frame(at) = frames[k].image;
   }
 
-  const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(context.method, run));
+  const Video sigma = PredictErrorSigma(scene, latent, ConfidenceFor(window_method, run));
 
   const auto write_start = Clock::now();
   // Written in place: --resume trusts a window only through its record, written last and
@@ -520,6 +527,10 @@ Json VideoSummary(const VideoRequest& request, const VideoResult& result, const 
   summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
   if (request.preview) summary["preview"] = "preview.mp4";
   summary["solver"] = MethodName(request.method.method);
+  if (result.log_offset_searched) {
+    summary["log_offset_search"] =
+        LogOffsetChoiceJson(result.log_offset_choice, result.log_offset_search_s);
+  }
   summary["settings"] = request.settings;
   summary["denoiser"] = denoiser;
   summary["events"] = result.events;
@@ -592,6 +603,70 @@ std::string VideoProgressLine(const VideoProgress& progress) {
       events_per_s / 1000.0);
   return line + text;
 }
+
+namespace {
+
+// VideoRequest::log_offset_search: each candidate b interpolates, on up to
+// kLogOffsetSearchTriplets pairs of neighbouring interpolation windows spread over the video, their
+// shared frame from the two outer ones; the best b serves every interpolation window
+// (app/log_offset_search.h).
+constexpr int kLogOffsetSearchTriplets = 2;
+
+void SearchLogOffset(const std::vector<VideoWindow>& windows, const SharedSource& source,
+                     const VideoRequest& request, int threads, VideoResult* result) {
+  const MethodOptions& method = request.method;
+  if (request.log_offset_search.empty() || !IsIterative(method.method) ||
+      method.reconstruction.objective.event_model.model != EventModel::kLog) {
+    return;
+  }
+  const auto start = Clock::now();
+  // Neighbouring interpolation windows that share a frame, all three frames sharp.
+  std::vector<size_t> pairs;
+  for (size_t i = 0; i + 1 < windows.size(); ++i) {
+    const VideoWindow& a = windows[i];
+    const VideoWindow& b = windows[i + 1];
+    if (a.kind != VideoWindowKind::kInterpolate || b.kind != VideoWindowKind::kInterpolate ||
+        a.frames[1].index != b.frames[0].index) {
+      continue;
+    }
+    if (a.frames[0].blurred || a.frames[1].blurred || b.frames[1].blurred) continue;
+    pairs.push_back(i);
+  }
+  std::vector<size_t> chosen;
+  const size_t count = std::min<size_t>(pairs.size(), kLogOffsetSearchTriplets);
+  for (size_t k = 0; k < count; ++k)
+    chosen.push_back(pairs[(2 * k + 1) * pairs.size() / (2 * count)]);
+  std::vector<ValidationTriplet> triplets;
+  std::vector<ValidationScene> scenes;
+  const auto read = [&source](const VideoWindowFrame& observed) {
+    TimedFrame frame;
+    frame.image = source.ReadImage(observed.index);
+    frame.exposure_begin_ns = observed.exposure_begin_ns;
+    frame.exposure_end_ns = observed.exposure_end_ns;
+    return frame;
+  };
+  for (const size_t i : chosen) {
+    const VideoWindow& a = windows[i];
+    const VideoWindow& b = windows[i + 1];
+    triplets.push_back({a.frames[0].index, a.frames[1].index, b.frames[1].index});
+    scenes.push_back(MakeValidationScene(read(a.frames[0]), read(b.frames[1]),
+                                         source.ReadImage(a.frames[1].index), a.frames[1].t_ns,
+                                         source.ReadEvents(a.begin_ns, b.end_ns), a.begin_ns,
+                                         b.end_ns, request.binning, kValidationSquarePx));
+  }
+  MethodOptions trial = method;
+  trial.reconstruction.solver.num_threads = threads;
+  const auto squared_error = [&](const ValidationTriplet& triplet, double b) {
+    return ValidationError(scenes[&triplet - triplets.data()], trial, b);
+  };
+  result->log_offset_choice =
+      ChooseLogOffset(request.log_offset_search, triplets,
+                      method.reconstruction.objective.event_model.log_offset, squared_error);
+  result->log_offset_searched = true;
+  result->log_offset_search_s = SecondsSince(start);
+}
+
+}  // namespace
 
 VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
                      const std::string& staging) {
@@ -668,7 +743,11 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
     request.notice("--jobs=" + std::to_string(request.jobs) + " lowered to " +
                    std::to_string(result.jobs) + ": " + schedule.lowered_because);
   }
+  SearchLogOffset(windows, source, request, cores, &result);
   WindowContext context;
+  if (result.log_offset_searched) {
+    context.interpolation_log_offset = result.log_offset_choice.chosen;
+  }
   context.request = &request;
   context.source = &source;
   context.clock = &clock;

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "evfs/app/denoise_job.h"
+#include "evfs/app/log_offset_search.h"
 #include "evfs/app/method.h"
 #include "evfs/app/video_windows.h"
 #include "evfs/events/binning.h"
@@ -84,6 +85,9 @@ struct VideoRequest {
   bool report = false;           // also report.html: the run on one offline page
   BinningOptions binning;
   MethodOptions method;  // solver threads are set per window from threads_per_window
+  /// The values of b tried for the interpolation windows (app/log_offset_search.h), each on two
+  /// of the video's observed frames reconstructed from their neighbours. Empty: the model's b.
+  std::vector<double> log_offset_search;
   DenoiseRequest denoise;
   /// Everything else that decides the output (the command line's settings); --resume reuses
   /// windows only when it is unchanged.
@@ -124,6 +128,10 @@ struct VideoResult {
   double mean_ssim = 0.0, worst_ssim = 0.0, mean_blend_ssim = 0.0;
   /// The share of the withheld frames' pixels within the predicted one sigma, averaged.
   double mean_within_sigma = 0.0;
+  /// What VideoRequest::log_offset_search chose (searched is false when it did not run).
+  bool log_offset_searched = false;
+  LogOffsetChoice log_offset_choice;
+  double log_offset_search_s = 0.0;
 };
 
 /// Runs the job: windows into the work folder of `out_path`, then frames/, timestamps.txt,

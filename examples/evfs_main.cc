@@ -311,6 +311,10 @@ int RunVideoCommand(ProgressReporter* progress) {
       static_cast<long long>(result.output_frames), result.fps, result.width, result.height,
       out.path().c_str(), result.windows_per_s, result.events_per_s, result.jobs,
       result.threads_per_window, result.codec.c_str());
+  if (result.log_offset_searched) {
+    std::printf("log offset of the interpolations: %s\n",
+                result.log_offset_choice.description.c_str());
+  }
   if (result.truth_frames > 0) {
     std::printf(
         "%d withheld frames: PSNR mean %.2f dB (worst %.2f, blend %.2f), SSIM mean %.4f "

@@ -377,7 +377,10 @@ def same_default(kind, text, value):
         return value is (text == "true")
     if kind == "string":
         text = text.strip('"')
-        return value == text if isinstance(value, str) else text == ",".join(map(str, value))
+        if isinstance(value, str):
+            return value == text
+        # A list of numbers: the same numbers (the CLI writes 5 where Python holds 5.0).
+        return [float(x) for x in text.split(",") if x] == [float(v) for v in value]
     return float(text) == float(value)
 
 

@@ -493,6 +493,7 @@ TEST(EvfsOptionsTest, EveryRequestFieldIsAnOptionOrSaysWhyNot) {
       "video.threads_per_window",
       "video.binning",
       "video.method",
+      "video.log_offset_search",
       "video.denoise",
       "video.windows.first",
       "video.windows.last",
