@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "evfs/core/parallel.h"
+
 namespace evfs {
 
 std::vector<ValidationTriplet> ValidationTriplets(int num_frames, const std::vector<int>& excluded,
@@ -36,7 +38,8 @@ std::vector<ValidationTriplet> ValidationTriplets(int num_frames, const std::vec
 LogOffsetChoice ChooseLogOffset(
     const std::vector<double>& candidates, const std::vector<ValidationTriplet>& triplets,
     double fallback,
-    const std::function<double(const ValidationTriplet& triplet, double b)>& squared_error) {
+    const std::function<double(const ValidationTriplet& triplet, double b)>& squared_error,
+    int workers) {
   LogOffsetChoice choice;
   choice.candidates = candidates;
   choice.triplets = triplets;
@@ -57,8 +60,11 @@ LogOffsetChoice ChooseLogOffset(
   std::vector<double> error(sorted.size(), -1.0);
   const auto evaluate = [&](size_t i) {
     if (error[i] < 0.0) {
+      std::vector<double> errors(triplets.size());
+      ParallelForEach(static_cast<int>(triplets.size()), workers,
+                      [&](int k) { errors[k] = squared_error(triplets[k], sorted[i]); });
       double total = 0.0;
-      for (const ValidationTriplet& triplet : triplets) total += squared_error(triplet, sorted[i]);
+      for (const double e : errors) total += e;
       error[i] = total / static_cast<double>(triplets.size());
       choice.psnr[i] = error[i] > 0.0 ? -10.0 * std::log10(error[i]) : 99.0;
     }

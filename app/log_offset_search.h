@@ -52,11 +52,13 @@ struct LogOffsetChoice {
 /// the middle frame interpolated with b) and keeps the least total. It starts at the candidate
 /// nearest `fallback` and moves to a neighbour while that one has less error (the error taken to
 /// have one minimum over b), so a minimum at one end is found after the candidates between.
-/// Without triplets or candidates `fallback` is kept.
+/// Without triplets or candidates `fallback` is kept. The triplets of one candidate are solved
+/// on up to `workers` threads at once (squared_error must allow it).
 LogOffsetChoice ChooseLogOffset(
     const std::vector<double>& candidates, const std::vector<ValidationTriplet>& triplets,
     double fallback,
-    const std::function<double(const ValidationTriplet& triplet, double b)>& squared_error);
+    const std::function<double(const ValidationTriplet& triplet, double b)>& squared_error,
+    int workers = 1);
 
 /// A square of the sensor, in pixels.
 struct PixelBox {
@@ -84,6 +86,7 @@ ValidationScene MakeValidationScene(const TimedFrame& first, const TimedFrame& l
                                     const BinningOptions& binning, int side);
 
 /// The mean squared error of the middle frame solved by `method` with b = `log_offset`.
+/// Safe to call from several threads at once.
 double ValidationError(const ValidationScene& validation, const MethodOptions& method,
                        double log_offset);
 

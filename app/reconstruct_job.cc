@@ -290,11 +290,16 @@ MethodOptions SearchedMethod(const DataSource& source, const ReconstructRequest&
                                          source.ReadEvents(begin, end), begin, end, request.binning,
                                          kValidationSquarePx));
   }
+  // The triplets side by side, the request's threads shared between them.
+  const int threads = method.reconstruction.solver.num_threads;
+  const int workers = std::max(1, std::min(threads, static_cast<int>(triplets.size())));
+  MethodOptions trial = method;
+  trial.reconstruction.solver.num_threads = std::max(1, threads / workers);
   const auto squared_error = [&](const ValidationTriplet& triplet, double b) {
-    return ValidationError(scenes[&triplet - triplets.data()], method, b);
+    return ValidationError(scenes[&triplet - triplets.data()], trial, b);
   };
-  result->log_offset_choice =
-      ChooseLogOffset(request.log_offset_search, triplets, model.log_offset, squared_error);
+  result->log_offset_choice = ChooseLogOffset(request.log_offset_search, triplets, model.log_offset,
+                                              squared_error, workers);
   result->log_offset_searched = true;
   result->log_offset_search_s = SecondsSince(start);
   model.log_offset = result->log_offset_choice.chosen;

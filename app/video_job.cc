@@ -654,14 +654,16 @@ void SearchLogOffset(const std::vector<VideoWindow>& windows, const SharedSource
                                          source.ReadEvents(a.begin_ns, b.end_ns), a.begin_ns,
                                          b.end_ns, request.binning, kValidationSquarePx));
   }
+  // The triplets side by side, the cores shared between them.
+  const int workers = std::max(1, std::min(threads, static_cast<int>(triplets.size())));
   MethodOptions trial = method;
-  trial.reconstruction.solver.num_threads = threads;
+  trial.reconstruction.solver.num_threads = std::max(1, threads / workers);
   const auto squared_error = [&](const ValidationTriplet& triplet, double b) {
     return ValidationError(scenes[&triplet - triplets.data()], trial, b);
   };
-  result->log_offset_choice =
-      ChooseLogOffset(request.log_offset_search, triplets,
-                      method.reconstruction.objective.event_model.log_offset, squared_error);
+  result->log_offset_choice = ChooseLogOffset(
+      request.log_offset_search, triplets, method.reconstruction.objective.event_model.log_offset,
+      squared_error, workers);
   result->log_offset_searched = true;
   result->log_offset_search_s = SecondsSince(start);
 }

@@ -52,6 +52,11 @@ TEST(LogOffsetSearch, KeepsTheCandidateWithTheLeastErrorOverAllTriplets) {
   ASSERT_EQ(choice.psnr.size(), 3u);
   EXPECT_NEAR(choice.psnr[1], -10.0 * std::log10((0.002 + 0.001) / 2.0), 1e-9);
   EXPECT_LT(choice.psnr[0], choice.psnr[1]);
+  // The triplets solved side by side: the same choice and scores.
+  const LogOffsetChoice side_by_side =
+      ChooseLogOffset({0.1, 1.0, 2.0}, triplets, 0.5, error, /*workers=*/2);
+  EXPECT_EQ(side_by_side.chosen, 1.0);
+  EXPECT_EQ(side_by_side.psnr, choice.psnr);
   // Equal errors: the candidate nearest the fallback (in log b) stays.
   const auto flat = [](const ValidationTriplet&, double) { return 0.001; };
   EXPECT_EQ(ChooseLogOffset({2.0, 0.1}, triplets, 0.5, flat).chosen, 2.0);
