@@ -2,10 +2,10 @@
 //
 // The offset the events' counts measure (evfs calibrate) is not the one a reconstruction between
 // two frames wants: on the shared recordings the count fit finds b ≈ 0.1 on both the DAVIS240
-// shapes clip and the DAVIS346 street clip, while the first interpolates best at 0.1 and the
-// second at 2 (docs/model.md, "Choosing b by the recording's own frames"). So the offset is chosen
-// as a user would check it: each candidate interpolates frames of the recording that the window
-// does not use from their neighbours, and the one with the least squared error is kept.
+// shapes clip and the DAVIS346 street clip, while the first interpolates best near 0.05 and the
+// second at 1.5 or more (docs/model.md, "Choosing b by the recording's own frames"). So the offset
+// is chosen as a user would check it: each candidate interpolates frames of the recording that the
+// window does not use from their neighbours, and the one with the least squared error is kept.
 #ifndef EVFS_APP_LOG_OFFSET_SEARCH_H_
 #define EVFS_APP_LOG_OFFSET_SEARCH_H_
 

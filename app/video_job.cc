@@ -634,8 +634,9 @@ void SearchLogOffset(const std::vector<VideoWindow>& windows, const SharedSource
   }
   std::vector<size_t> chosen;
   const size_t count = std::min<size_t>(pairs.size(), kLogOffsetSearchTriplets);
-  for (size_t k = 0; k < count; ++k)
+  for (size_t k = 0; k < count; ++k) {
     chosen.push_back(pairs[(2 * k + 1) * pairs.size() / (2 * count)]);
+  }
   std::vector<ValidationTriplet> triplets;
   std::vector<ValidationScene> scenes;
   const auto read = [&source](const VideoWindowFrame& observed) {
