@@ -35,11 +35,10 @@ std::vector<ValidationTriplet> ValidationTriplets(int num_frames, const std::vec
   return triplets;
 }
 
-LogOffsetChoice ChooseLogOffset(
-    const std::vector<double>& candidates, const std::vector<ValidationTriplet>& triplets,
-    double fallback,
-    const std::function<double(const ValidationTriplet& triplet, double b)>& squared_error,
-    int workers) {
+LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,
+                                const std::vector<ValidationTriplet>& triplets, double fallback,
+                                const std::function<double(int triplet, double b)>& squared_error,
+                                int workers) {
   LogOffsetChoice choice;
   choice.candidates = candidates;
   choice.triplets = triplets;
@@ -62,7 +61,7 @@ LogOffsetChoice ChooseLogOffset(
     if (error[i] < 0.0) {
       std::vector<double> errors(triplets.size());
       ParallelForEach(static_cast<int>(triplets.size()), workers,
-                      [&](int k) { errors[k] = squared_error(triplets[k], sorted[i]); });
+                      [&](int k) { errors[k] = squared_error(k, sorted[i]); });
       double total = 0.0;
       for (const double e : errors) total += e;
       error[i] = total / static_cast<double>(triplets.size());
@@ -173,6 +172,23 @@ double ValidationError(const ValidationScene& validation, const MethodOptions& m
   const MethodResult run = RunMethod(validation.scene, trial, IterationCallback(), false, nullptr);
   const Image& estimate = run.video.frame(run.video.NearestFrame(validation.middle_ns));
   return (estimate - validation.middle).square().mean();
+}
+
+bool SearchesLogOffset(const MethodOptions& method) {
+  return IsIterative(method.method) &&
+         method.reconstruction.objective.event_model.model == EventModel::kLog;
+}
+
+LogOffsetChoice ChooseLogOffsetOn(const std::vector<double>& candidates,
+                                  const std::vector<ValidationTriplet>& triplets,
+                                  const std::vector<ValidationScene>& scenes,
+                                  const MethodOptions& method, int threads) {
+  const int workers = std::max(1, std::min(threads, static_cast<int>(triplets.size())));
+  MethodOptions trial = method;
+  trial.reconstruction.solver.num_threads = std::max(1, threads / workers);
+  return ChooseLogOffset(
+      candidates, triplets, method.reconstruction.objective.event_model.log_offset,
+      [&](int k, double b) { return ValidationError(scenes[k], trial, b); }, workers);
 }
 
 }  // namespace evfs

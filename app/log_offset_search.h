@@ -46,19 +46,19 @@ struct LogOffsetChoice {
   std::vector<double> psnr;  // per candidate; empty when no triplet was scored
   double chosen = 0.0;       // the best candidate, or `fallback` without triplets
   std::string description;   // one line for logs
+  double seconds = 0.0;      // the whole search: reading, cropping and solving the triplets
 };
 
-/// Scores candidates on every triplet with `squared_error(triplet, b)` (the mean squared error of
-/// the middle frame interpolated with b) and keeps the least total. It starts at the candidate
-/// nearest `fallback` and moves to a neighbour while that one has less error (the error taken to
-/// have one minimum over b), so a minimum at one end is found after the candidates between.
-/// Without triplets or candidates `fallback` is kept. The triplets of one candidate are solved
-/// on up to `workers` threads at once (squared_error must allow it).
-LogOffsetChoice ChooseLogOffset(
-    const std::vector<double>& candidates, const std::vector<ValidationTriplet>& triplets,
-    double fallback,
-    const std::function<double(const ValidationTriplet& triplet, double b)>& squared_error,
-    int workers = 1);
+/// Scores candidates on every triplet with `squared_error(k, b)` (the mean squared error of the
+/// middle frame of triplets[k] interpolated with b) and keeps the least total. It starts at the
+/// candidate nearest `fallback` and moves to a neighbour while that one has less error (the error
+/// taken to have one minimum over b), so a minimum at one end is found after the candidates
+/// between. Without triplets or candidates `fallback` is kept. The triplets of one candidate are
+/// solved on up to `workers` threads at once (squared_error must allow it).
+LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,
+                                const std::vector<ValidationTriplet>& triplets, double fallback,
+                                const std::function<double(int triplet, double b)>& squared_error,
+                                int workers = 1);
 
 /// A square of the sensor, in pixels.
 struct PixelBox {
@@ -90,9 +90,24 @@ ValidationScene MakeValidationScene(const TimedFrame& first, const TimedFrame& l
 double ValidationError(const ValidationScene& validation, const MethodOptions& method,
                        double log_offset);
 
+/// Whether `method` reads events through b, so that a search can choose it: the iterative solvers
+/// with the log model.
+bool SearchesLogOffset(const MethodOptions& method);
+
+/// ChooseLogOffset on `scenes` (one per triplet, the same order) with ValidationError, starting
+/// from the b of `method`. The triplets are solved side by side, `threads` shared between them.
+/// The caller sets `seconds`.
+LogOffsetChoice ChooseLogOffsetOn(const std::vector<double>& candidates,
+                                  const std::vector<ValidationTriplet>& triplets,
+                                  const std::vector<ValidationScene>& scenes,
+                                  const MethodOptions& method, int threads);
+
 /// The values of b the command line tries by default (--log_offset_search): the model's default
 /// 0.5 and two on each side of it, each about three times the one before.
 inline constexpr char kDefaultLogOffsetSearch[] = "0.05,0.15,0.5,1.5,5";
+
+/// Triplets a search solves per candidate, at most.
+constexpr int kLogOffsetSearchTriplets = 2;
 
 /// Side of the square the validation solves are cropped to, in pixels.
 constexpr int kValidationSquarePx = 64;

@@ -25,9 +25,6 @@ using Clock = std::chrono::steady_clock;
 // Most frames --fps may resample the latent video to (a runaway rate would fill memory).
 constexpr double kMaxOutputFrames = 10000;
 
-// Frames outside the window ReconstructRequest::log_offset_search interpolates per candidate.
-constexpr int kLogOffsetSearchTriplets = 2;
-
 void CheckFrameIndex(const DataSource& source, int index, const char* what) {
   const int count = static_cast<int>(source.frames().size());
   if (count == 0) {
@@ -263,9 +260,8 @@ void ScoreTruth(const Video& latent, const Video& baseline, const Video& sigma,
 MethodOptions SearchedMethod(const DataSource& source, const ReconstructRequest& request, int last,
                              const SharpFrameTiming& timing, ReconstructResult* result) {
   MethodOptions method = request.method;
-  EventModelParams& model = method.reconstruction.objective.event_model;
   if (request.log_offset_search.empty() || request.mode != Mode::kInterpolate ||
-      !IsIterative(method.method) || model.model != EventModel::kLog) {
+      !SearchesLogOffset(method)) {
     return method;
   }
   const auto start = Clock::now();
@@ -290,19 +286,11 @@ MethodOptions SearchedMethod(const DataSource& source, const ReconstructRequest&
                                          source.ReadEvents(begin, end), begin, end, request.binning,
                                          kValidationSquarePx));
   }
-  // The triplets side by side, the request's threads shared between them.
-  const int threads = method.reconstruction.solver.num_threads;
-  const int workers = std::max(1, std::min(threads, static_cast<int>(triplets.size())));
-  MethodOptions trial = method;
-  trial.reconstruction.solver.num_threads = std::max(1, threads / workers);
-  const auto squared_error = [&](const ValidationTriplet& triplet, double b) {
-    return ValidationError(scenes[&triplet - triplets.data()], trial, b);
-  };
-  result->log_offset_choice = ChooseLogOffset(request.log_offset_search, triplets, model.log_offset,
-                                              squared_error, workers);
-  result->log_offset_searched = true;
-  result->log_offset_search_s = SecondsSince(start);
-  model.log_offset = result->log_offset_choice.chosen;
+  LogOffsetChoice choice = ChooseLogOffsetOn(request.log_offset_search, triplets, scenes, method,
+                                             method.reconstruction.solver.num_threads);
+  choice.seconds = SecondsSince(start);
+  method.reconstruction.objective.event_model.log_offset = choice.chosen;
+  result->log_offset_choice = std::move(choice);
   return method;
 }
 
@@ -544,10 +532,9 @@ std::string SummaryJson(const ReconstructRequest& request, const ReconstructResu
   json["solver"] = std::move(solver);
   if (iterative) {
     json["model"] = ModelJson(options.objective, summary);
-    if (result.log_offset_searched) {
-      json["model"]["log_offset"] = Number(result.log_offset_choice.chosen);
-      json["model"]["log_offset_search"] =
-          LogOffsetChoiceJson(result.log_offset_choice, result.log_offset_search_s);
+    if (result.log_offset_choice) {
+      json["model"]["log_offset"] = Number(result.log_offset_choice->chosen);
+      json["model"]["log_offset_search"] = LogOffsetChoiceJson(*result.log_offset_choice);
     }
     json["solved"] = run.solved;
     json["iterations"] = run.iterations;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -112,10 +113,8 @@ struct ReconstructResult {
   /// represents lies after its timestamp (the first frame's exposure middle for start, middle,
   /// end).
   FrameLagEstimate frame_lag;
-  /// What ReconstructRequest::log_offset_search chose (searched is false when it did not run).
-  bool log_offset_searched = false;
-  LogOffsetChoice log_offset_choice;
-  double log_offset_search_s = 0.0;  // its solves, before the window's
+  /// What ReconstructRequest::log_offset_search chose; empty when it did not run.
+  std::optional<LogOffsetChoice> log_offset_choice;
   int64_t frame_shift_ns = 0;
 };
 

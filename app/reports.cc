@@ -203,8 +203,8 @@ void PrintReconstruction(const ReconstructRequest& request, const ReconstructRes
         request.frame_time == FrameTime::kAuto ? result.frame_lag.description.c_str() : "");
   }
   if (IsIterative(request.method.method)) {
-    if (result.log_offset_searched) {
-      std::fprintf(out, "log offset: %s\n", result.log_offset_choice.description.c_str());
+    if (result.log_offset_choice) {
+      std::fprintf(out, "log offset: %s\n", result.log_offset_choice->description.c_str());
     }
     std::fprintf(out, "model: %s\n", run.reconstruction.model.description.c_str());
     if (run.solved) {

@@ -22,7 +22,7 @@ nlohmann::ordered_json CeresWorkJson(const ceres::Solver::Summary& summary) {
   return json;
 }
 
-nlohmann::ordered_json LogOffsetChoiceJson(const LogOffsetChoice& choice, double seconds) {
+nlohmann::ordered_json LogOffsetChoiceJson(const LogOffsetChoice& choice) {
   nlohmann::ordered_json frames = nlohmann::ordered_json::array();
   for (const ValidationTriplet& t : choice.triplets) frames.push_back({t.first, t.middle, t.last});
   nlohmann::ordered_json psnr = nlohmann::ordered_json::array();
@@ -31,7 +31,7 @@ nlohmann::ordered_json LogOffsetChoiceJson(const LogOffsetChoice& choice, double
           {"frames", std::move(frames)},
           {"psnr", std::move(psnr)},
           {"chosen", Number(choice.chosen)},
-          {"time_s", Number(seconds)}};
+          {"time_s", Number(choice.seconds)}};
 }
 
 }  // namespace evfs

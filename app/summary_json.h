@@ -22,7 +22,7 @@ nlohmann::ordered_json Number(double value);
 nlohmann::ordered_json CeresWorkJson(const ceres::Solver::Summary& summary);
 
 /// What a log offset search tried and chose (app/log_offset_search.h), and its time.
-nlohmann::ordered_json LogOffsetChoiceJson(const LogOffsetChoice& choice, double seconds);
+nlohmann::ordered_json LogOffsetChoiceJson(const LogOffsetChoice& choice);
 
 }  // namespace evfs
 

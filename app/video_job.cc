@@ -142,6 +142,16 @@ std::string ReadWindowInputHash(const VideoWindow& window, const SharedSource& s
   return hash.Hex();
 }
 
+// A window's frame as the scene takes it: its image, exposure and file name.
+TimedFrame ReadWindowFrame(const SharedSource& source, const VideoWindowFrame& observed) {
+  TimedFrame frame;
+  frame.image = source.ReadImage(observed.index);
+  frame.exposure_begin_ns = observed.exposure_begin_ns;
+  frame.exposure_end_ns = observed.exposure_end_ns;
+  frame.label = source.unlocked().frames()[observed.index].path;
+  return frame;
+}
+
 // Solves one window, writes the output frames it owns into the work folder and returns its
 // record (written last).
 Json RunWindow(const VideoWindow& window, const WindowContext& context) {
@@ -149,12 +159,7 @@ Json RunWindow(const VideoWindow& window, const WindowContext& context) {
   const VideoRequest& request = *context.request;
   std::vector<TimedFrame> frames;
   for (const VideoWindowFrame& observed : window.frames) {
-    TimedFrame frame;
-    frame.image = context.source->ReadImage(observed.index);
-    frame.exposure_begin_ns = observed.exposure_begin_ns;
-    frame.exposure_end_ns = observed.exposure_end_ns;
-    frame.label = context.source->unlocked().frames()[observed.index].path;
-    frames.push_back(std::move(frame));
+    frames.push_back(ReadWindowFrame(*context.source, observed));
   }
   const EventStream events = context.source->ReadEvents(window.begin_ns, window.end_ns);
   WindowInputHash input_hash;
@@ -527,9 +532,8 @@ Json VideoSummary(const VideoRequest& request, const VideoResult& result, const 
   summary["video"] = {{"file", "video.mp4"}, {"codec", result.codec}};
   if (request.preview) summary["preview"] = "preview.mp4";
   summary["solver"] = MethodName(request.method.method);
-  if (result.log_offset_searched) {
-    summary["log_offset_search"] =
-        LogOffsetChoiceJson(result.log_offset_choice, result.log_offset_search_s);
+  if (result.log_offset_choice) {
+    summary["log_offset_search"] = LogOffsetChoiceJson(*result.log_offset_choice);
   }
   summary["settings"] = request.settings;
   summary["denoiser"] = denoiser;
@@ -610,15 +614,9 @@ namespace {
 // kLogOffsetSearchTriplets pairs of neighbouring interpolation windows spread over the video, their
 // shared frame from the two outer ones; the best b serves every interpolation window
 // (app/log_offset_search.h).
-constexpr int kLogOffsetSearchTriplets = 2;
-
 void SearchLogOffset(const std::vector<VideoWindow>& windows, const SharedSource& source,
                      const VideoRequest& request, int threads, VideoResult* result) {
-  const MethodOptions& method = request.method;
-  if (request.log_offset_search.empty() || !IsIterative(method.method) ||
-      method.reconstruction.objective.event_model.model != EventModel::kLog) {
-    return;
-  }
+  if (request.log_offset_search.empty() || !SearchesLogOffset(request.method)) return;
   const auto start = Clock::now();
   // Neighbouring interpolation windows that share a frame, all three frames sharp.
   std::vector<size_t> pairs;
@@ -632,41 +630,24 @@ void SearchLogOffset(const std::vector<VideoWindow>& windows, const SharedSource
     if (a.frames[0].blurred || a.frames[1].blurred || b.frames[1].blurred) continue;
     pairs.push_back(i);
   }
-  std::vector<size_t> chosen;
   const size_t count = std::min<size_t>(pairs.size(), kLogOffsetSearchTriplets);
-  for (size_t k = 0; k < count; ++k) {
-    chosen.push_back(pairs[(2 * k + 1) * pairs.size() / (2 * count)]);
-  }
   std::vector<ValidationTriplet> triplets;
   std::vector<ValidationScene> scenes;
-  const auto read = [&source](const VideoWindowFrame& observed) {
-    TimedFrame frame;
-    frame.image = source.ReadImage(observed.index);
-    frame.exposure_begin_ns = observed.exposure_begin_ns;
-    frame.exposure_end_ns = observed.exposure_end_ns;
-    return frame;
-  };
-  for (const size_t i : chosen) {
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = pairs[(2 * k + 1) * pairs.size() / (2 * count)];
     const VideoWindow& a = windows[i];
     const VideoWindow& b = windows[i + 1];
     triplets.push_back({a.frames[0].index, a.frames[1].index, b.frames[1].index});
-    scenes.push_back(MakeValidationScene(read(a.frames[0]), read(b.frames[1]),
+    scenes.push_back(MakeValidationScene(ReadWindowFrame(source, a.frames[0]),
+                                         ReadWindowFrame(source, b.frames[1]),
                                          source.ReadImage(a.frames[1].index), a.frames[1].t_ns,
                                          source.ReadEvents(a.begin_ns, b.end_ns), a.begin_ns,
                                          b.end_ns, request.binning, kValidationSquarePx));
   }
-  // The triplets side by side, the cores shared between them.
-  const int workers = std::max(1, std::min(threads, static_cast<int>(triplets.size())));
-  MethodOptions trial = method;
-  trial.reconstruction.solver.num_threads = std::max(1, threads / workers);
-  const auto squared_error = [&](const ValidationTriplet& triplet, double b) {
-    return ValidationError(scenes[&triplet - triplets.data()], trial, b);
-  };
-  result->log_offset_choice = ChooseLogOffset(
-      request.log_offset_search, triplets, method.reconstruction.objective.event_model.log_offset,
-      squared_error, workers);
-  result->log_offset_searched = true;
-  result->log_offset_search_s = SecondsSince(start);
+  LogOffsetChoice choice =
+      ChooseLogOffsetOn(request.log_offset_search, triplets, scenes, request.method, threads);
+  choice.seconds = SecondsSince(start);
+  result->log_offset_choice = std::move(choice);
 }
 
 }  // namespace
@@ -748,8 +729,8 @@ VideoResult RunVideo(const VideoRequest& request, const std::string& out_path,
   }
   SearchLogOffset(windows, source, request, cores, &result);
   WindowContext context;
-  if (result.log_offset_searched) {
-    context.interpolation_log_offset = result.log_offset_choice.chosen;
+  if (result.log_offset_choice) {
+    context.interpolation_log_offset = result.log_offset_choice->chosen;
   }
   context.request = &request;
   context.source = &source;

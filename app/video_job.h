@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -128,10 +129,8 @@ struct VideoResult {
   double mean_ssim = 0.0, worst_ssim = 0.0, mean_blend_ssim = 0.0;
   /// The share of the withheld frames' pixels within the predicted one sigma, averaged.
   double mean_within_sigma = 0.0;
-  /// What VideoRequest::log_offset_search chose (searched is false when it did not run).
-  bool log_offset_searched = false;
-  LogOffsetChoice log_offset_choice;
-  double log_offset_search_s = 0.0;
+  /// What VideoRequest::log_offset_search chose; empty when it did not run.
+  std::optional<LogOffsetChoice> log_offset_choice;
 };
 
 /// Runs the job: windows into the work folder of `out_path`, then frames/, timestamps.txt,

@@ -311,9 +311,9 @@ int RunVideoCommand(ProgressReporter* progress) {
       static_cast<long long>(result.output_frames), result.fps, result.width, result.height,
       out.path().c_str(), result.windows_per_s, result.events_per_s, result.jobs,
       result.threads_per_window, result.codec.c_str());
-  if (result.log_offset_searched) {
+  if (result.log_offset_choice) {
     std::printf("log offset of the interpolations: %s\n",
-                result.log_offset_choice.description.c_str());
+                result.log_offset_choice->description.c_str());
   }
   if (result.truth_frames > 0) {
     std::printf(

@@ -43,8 +43,8 @@ TEST(LogOffsetSearch, TripletsSkipTheExcludedFramesAndPreferTheNearest) {
 TEST(LogOffsetSearch, KeepsTheCandidateWithTheLeastErrorOverAllTriplets) {
   const std::vector<ValidationTriplet> triplets = {{0, 1, 2}, {2, 3, 4}};
   // Triplet 1 alone would choose 0.1; summed over both, 1 has the least error.
-  const auto error = [](const ValidationTriplet& triplet, double b) {
-    if (triplet.middle == 1) return b == 0.1 ? 0.001 : 0.002;
+  const auto error = [&triplets](int k, double b) {
+    if (triplets[k].middle == 1) return b == 0.1 ? 0.001 : 0.002;
     return std::abs(std::log(b)) * 0.01 + 0.001;
   };
   const LogOffsetChoice choice = ChooseLogOffset({0.1, 1.0, 2.0}, triplets, 0.5, error);
@@ -58,7 +58,7 @@ TEST(LogOffsetSearch, KeepsTheCandidateWithTheLeastErrorOverAllTriplets) {
   EXPECT_EQ(side_by_side.chosen, 1.0);
   EXPECT_EQ(side_by_side.psnr, choice.psnr);
   // Equal errors: the candidate nearest the fallback (in log b) stays.
-  const auto flat = [](const ValidationTriplet&, double) { return 0.001; };
+  const auto flat = [](int, double) { return 0.001; };
   EXPECT_EQ(ChooseLogOffset({2.0, 0.1}, triplets, 0.5, flat).chosen, 2.0);
   EXPECT_EQ(ChooseLogOffset({2.0, 0.1}, triplets, 0.2, flat).chosen, 0.1);
   // Nothing to score: the fallback, said so.
@@ -72,7 +72,7 @@ TEST(LogOffsetSearch, WalksFromTheFallbackAndStopsWhereTheErrorRisesAgain) {
   const std::vector<ValidationTriplet> triplets = {{0, 1, 2}};
   int solves = 0;
   const auto valley_at = [&solves](double minimum) {
-    return [&solves, minimum](const ValidationTriplet&, double b) {
+    return [&solves, minimum](int, double b) {
       ++solves;
       return 0.001 + std::pow(std::log(b / minimum), 2);
     };
@@ -106,8 +106,8 @@ TEST(LogOffsetSearch, ReconstructionChoosesOnFramesOutsideTheWindowAndTheTruth) 
   request.truth = 3;
   request.log_offset_search = {0.1, 2.0};
   const ReconstructResult result = RunReconstruction(request);
-  ASSERT_TRUE(result.log_offset_searched);
-  const LogOffsetChoice& choice = result.log_offset_choice;
+  ASSERT_TRUE(result.log_offset_choice.has_value());
+  const LogOffsetChoice& choice = *result.log_offset_choice;
   ASSERT_EQ(choice.triplets.size(), 2u);
   for (const ValidationTriplet& triplet : choice.triplets) {
     for (const int frame : {triplet.first, triplet.middle, triplet.last}) EXPECT_NE(frame, 3);
@@ -117,13 +117,14 @@ TEST(LogOffsetSearch, ReconstructionChoosesOnFramesOutsideTheWindowAndTheTruth) 
   ASSERT_EQ(choice.psnr.size(), 2u);
   EXPECT_GT(choice.psnr[0], choice.psnr[1]);
   EXPECT_GE(result.truth.psnr, 37.0);
+  EXPECT_GT(choice.seconds, 0.0);
   EXPECT_NE(SummaryJson(request, result).find("\"log_offset_search\""), std::string::npos);
   // A prediction does not search.
   request.mode = Mode::kPredict;
   request.first = 2;
   request.last = 3;
   request.method.method = Method::kCopy;
-  EXPECT_FALSE(RunReconstruction(request).log_offset_searched);
+  EXPECT_FALSE(RunReconstruction(request).log_offset_choice.has_value());
 }
 
 }  // namespace
