@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <vector>
@@ -70,7 +71,7 @@ TEST(LogOffsetSearch, KeepsTheCandidateWithTheLeastErrorOverAllTriplets) {
 
 TEST(LogOffsetSearch, WalksFromTheFallbackAndStopsWhereTheErrorRisesAgain) {
   const std::vector<ValidationTriplet> triplets = {{0, 1, 2}};
-  int solves = 0;
+  std::atomic<int> solves{0};
   const auto valley_at = [&solves](double minimum) {
     return [&solves, minimum](int, double b) {
       ++solves;
@@ -92,6 +93,11 @@ TEST(LogOffsetSearch, WalksFromTheFallbackAndStopsWhereTheErrorRisesAgain) {
   EXPECT_EQ(solves, 4);
   solves = 0;
   EXPECT_EQ(ChooseLogOffset(candidates, triplets, 0.5, valley_at(1.4)).chosen, 1.5);
+  EXPECT_EQ(solves, 4);
+  // Solves side by side (the first step's three at once): the same solves and choice.
+  solves = 0;
+  EXPECT_EQ(ChooseLogOffset(candidates, triplets, 0.5, valley_at(0.04), /*workers=*/3).chosen,
+            0.05);
   EXPECT_EQ(solves, 4);
 }
 

@@ -116,6 +116,16 @@ TEST(EvfsVideo, AWholeRecordingBecomesUniformFramesWithTheObservedOnesUnchanged)
     EXPECT_GE(window["ceres"]["jacobian_evaluations"].get<int>(), 1);
     EXPECT_GE(window["ceres"]["time_s"]["linear_solver"].get<double>(), 0.0);
   }
+  // b of the interpolations chosen on one pair of neighbouring windows (one pair per ten
+  // windows, at least one): its shared frame from the outer two.
+  const nlohmann::json& search = summary["log_offset_search"];
+  ASSERT_EQ(search["frames"].size(), 1u) << search.dump();
+  const nlohmann::json& triplet = search["frames"][0];
+  EXPECT_EQ(triplet[1].get<int>(), triplet[0].get<int>() + 1);
+  EXPECT_EQ(triplet[2].get<int>(), triplet[1].get<int>() + 1);
+  const std::vector<double> candidates = search["candidates"].get<std::vector<double>>();
+  EXPECT_NE(std::find(candidates.begin(), candidates.end(), search["chosen"].get<double>()),
+            candidates.end());
   EXPECT_TRUE(summary["video"]["codec"] == "avc1" || summary["video"]["codec"] == "mp4v");
   EXPECT_GT(fs::file_size(out / "video.mp4"), 0u);
   // Nothing left beside the output: no staging folder, no work folder.
