@@ -7,7 +7,9 @@
 #   default       evfs reconstruct --mode=deblur as it runs by default;
 #   calibrated    the same with --event_model=MODEL.json from `evfs calibrate` on the clip's
 #                 8 sharp frames (the sensor's model, measured where it can be);
-#   edi           --solver=edi with the simulator's threshold, --contrast_threshold=0.2.
+#   edi           --solver=edi with the simulator's threshold, --contrast_threshold=0.2;
+#   edi_search    --solver=edi choosing its threshold by its sharpness criterion, as a user who
+#                 does not know the threshold would run it.
 #
 #   benchmarks/clip_deblurs.sh EVFS [SCRATCH_DIR] [DATA_DIR] [SIDE] [-- EXTRA_FLAGS...]
 #
@@ -25,8 +27,8 @@ cd "$(dirname "$0")/.."
 helper="python3 benchmarks/clip_deblur_helper.py"
 frames=8
 mkdir -p "$scratch"
-echo "| clip | default | calibrated | edi (threshold 0.2) | calibrated b, C_on, C_off |"
-echo "|---|---|---|---|---|"
+echo "| clip | default | calibrated | edi (threshold 0.2) | edi (searched threshold) | calibrated b, C_on, C_off |"
+echo "|---|---|---|---|---|---|"
 for clip in $(grep -v "^#" benchmarks/clips.txt | cut -d' ' -f1); do
   dir="$scratch/$clip"
   if [ ! -f "$dir/blurred/events.txt" ]; then
@@ -39,10 +41,10 @@ for clip in $(grep -v "^#" benchmarks/clips.txt | cut -d' ' -f1); do
       --progress_interval_s=0 > "$dir/calibrate.log"
   row="| $clip |"
   for run in "default:" "calibrated:--event_model=$dir/model.json" \
-             "edi:--solver=edi --contrast_threshold=0.2"; do
+             "edi:--solver=edi --contrast_threshold=0.2" "edi_search:--solver=edi"; do
     label=${run%%:*}
     read -r -a flags <<< "${run#*:}"
-    [ "$label" = edi ] || flags+=("${extra[@]}")
+    case $label in edi*) ;; *) flags+=("${extra[@]}") ;; esac
     out="$dir/out_$label"
     "$evfs" reconstruct --data="$dir/blurred" --mode=deblur --first=0 --last=0 --fps=960 \
         --out="$out" --overwrite --progress_interval_s=0 "${flags[@]}" > "$dir/$label.log"
