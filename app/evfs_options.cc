@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <sstream>
@@ -114,7 +115,9 @@ void SetSmoothingContinuation(const OptionValue& value, const std::string& flag,
 void SetLogOffsetSearch(const OptionValue& value, const std::string& flag, EvfsSettings* settings) {
   settings->reconstruct.log_offset_search = ParseNumberList(std::get<std::string>(value), flag);
   for (const double b : settings->reconstruct.log_offset_search) {
-    if (!(b > 0.0)) throw InvalidArgumentError(flag + " values must be > 0");
+    if (!(b > 0.0) || !std::isfinite(b)) {
+      throw InvalidArgumentError(flag + " values must be finite and > 0");
+    }
   }
 }
 

@@ -55,7 +55,15 @@ LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,
   // over b: the candidates beyond it are not solved.
   std::vector<double> sorted = candidates;
   std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
   choice.candidates = sorted;
+  if (sorted.size() == 1) {
+    choice.chosen = sorted[0];
+    char line[96];
+    std::snprintf(line, sizeof(line), "b %.3g (the only candidate: nothing solved)", sorted[0]);
+    choice.description = line;
+    return choice;
+  }
   choice.psnr.assign(sorted.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<double> error(sorted.size(), -1.0);
   // Solves every triplet of the candidates not solved yet, up to `workers` solves at once.

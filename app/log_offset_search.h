@@ -37,9 +37,9 @@ std::vector<ValidationTriplet> ValidationTriplets(int num_frames, const std::vec
                                                   const std::function<int64_t(int)>& time_ns,
                                                   int64_t near_ns, int max_triplets);
 
-/// What the search found: the candidates in increasing order, each one's PSNR over the triplets
-/// (their mean squared error over all pixels, as one PSNR; NaN where it was not solved) and the
-/// chosen b.
+/// What the search found: the candidates in increasing order, each once, each one's PSNR over the
+/// triplets (their mean squared error over all pixels, as one PSNR; NaN where it was not solved)
+/// and the chosen b.
 struct LogOffsetChoice {
   std::vector<double> candidates;
   std::vector<ValidationTriplet> triplets;
@@ -53,7 +53,8 @@ struct LogOffsetChoice {
 /// middle frame of triplets[k] interpolated with b) and keeps the least total. It starts at the
 /// candidate nearest `fallback` and moves to a neighbour while that one has less error (the error
 /// taken to have one minimum over b), so a minimum at one end is found after the candidates
-/// between. Without triplets or candidates `fallback` is kept. Each step solves the candidates
+/// between. Without triplets or candidates `fallback` is kept; a single candidate is chosen
+/// without a solve. Each step solves the candidates
 /// around the current one that are not solved yet (three at the start, then one), every triplet
 /// of each, up to `workers` solves at once (squared_error must allow it).
 LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,

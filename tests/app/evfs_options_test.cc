@@ -216,6 +216,12 @@ TEST(EvfsOptionsTest, BuildersSetTheBoundFields) {
   OptionValues bad;
   bad.Set("binning", std::string("sideways"));
   EXPECT_THROW(ReconstructRequestFromOptions(bad, false), InvalidArgumentError);
+  // Every value of b to search is a finite positive number.
+  for (const char* list : {"0.5,inf", "0,1", "nan", "-1"}) {
+    OptionValues search;
+    search.Set("log_offset_search", std::string(list));
+    EXPECT_THROW(ReconstructRequestFromOptions(search, false), InvalidArgumentError) << list;
+  }
   // A command that reads no binning option is not stopped by one.
   EXPECT_NO_THROW(SimulatorFromOptions(bad));
 }

@@ -94,6 +94,16 @@ TEST(LogOffsetSearch, WalksFromTheFallbackAndStopsWhereTheErrorRisesAgain) {
   solves = 0;
   EXPECT_EQ(ChooseLogOffset(candidates, triplets, 0.5, valley_at(1.4)).chosen, 1.5);
   EXPECT_EQ(solves, 4);
+  // Repeated candidates are solved once; a single one is chosen without a solve.
+  solves = 0;
+  choice = ChooseLogOffset({0.5, 0.05, 0.5, 0.05}, triplets, 0.5, valley_at(0.04));
+  EXPECT_EQ(choice.candidates, (std::vector<double>{0.05, 0.5}));
+  EXPECT_EQ(choice.chosen, 0.05);
+  EXPECT_EQ(solves, 2);
+  solves = 0;
+  choice = ChooseLogOffset({1.5, 1.5}, triplets, 0.5, valley_at(0.04));
+  EXPECT_EQ(choice.chosen, 1.5);
+  EXPECT_EQ(solves, 0);
   // Solves side by side (the first step's three at once): the same solves and choice.
   solves = 0;
   EXPECT_EQ(ChooseLogOffset(candidates, triplets, 0.5, valley_at(0.04), /*workers=*/3).chosen,
