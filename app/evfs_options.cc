@@ -369,10 +369,11 @@ std::vector<OptionDefinition> MakeEvfsOptions() {
       Row("log_offset_search", "model", "reconstruct video", kReconstructKey | kNumberList,
           Text(kDefaultLogOffsetSearch),
           "Comma-separated values of b tried for the windows between two frames (not when "
-          "--log_offset or a calibrated --event_model gives b): each reconstructs two frames of "
-          "the recording from their neighbours (reconstruct: the nearest the window does not "
-          "use, nor --truth; video: two of its observed frames), and the best replaces "
-          "--log_offset there; without three such frames, or empty: --log_offset.",
+          "--log_offset or a calibrated --event_model gives b): each reconstructs up to two "
+          "frames of the recording from their neighbours (reconstruct: the nearest the window "
+          "does not use, nor --truth; video: one of its observed frames per ten windows), and "
+          "the best replaces --log_offset there; without three such frames, or empty: "
+          "--log_offset.",
           Custom("reconstruct.log_offset_search", SetLogOffsetSearch)),
       Row("spatial_tv", "model", "reconstruct video", kReconstructKey, Text("anisotropic"),
           "paper (|dx+dy|) | anisotropic (|dx|+|dy|) | isotropic (sqrt(dx^2+dy^2)).",

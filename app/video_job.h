@@ -86,8 +86,9 @@ struct VideoRequest {
   bool report = false;           // also report.html: the run on one offline page
   BinningOptions binning;
   MethodOptions method;  // solver threads are set per window from threads_per_window
-  /// The values of b tried for the interpolation windows (app/log_offset_search.h), each on two
-  /// of the video's observed frames reconstructed from their neighbours. Empty: the model's b.
+  /// The values of b tried for the interpolation windows (app/log_offset_search.h), each on one
+  /// of the video's observed frames per ten windows (at most two) reconstructed from their
+  /// neighbours. Empty: the model's b.
   std::vector<double> log_offset_search;
   DenoiseRequest denoise;
   /// Everything else that decides the output (the command line's settings); --resume reuses
