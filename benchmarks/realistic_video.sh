@@ -15,7 +15,9 @@
 # --mode=interpolate --first=K-1 --last=K+1 --truth=K`), with the frames at their timestamps
 # (`--frame_time=instant`, reconstruct's default) and as the mean over their exposures
 # (`--frame_time=middle`, which reads exposures.txt; `--exposure_s=0.000001` gives the withheld
-# sharp frame, which has no exposure, an instant one). Prints one markdown row per clip and
+# sharp frame, which has no exposure, an instant one), with the b of g = log(I + b) the video used
+# (`--log_offset`: one by one, a window would choose b on the camera frames the video withholds,
+# docs/model.md "Choosing b by the recording's own frames"). Prints one markdown row per clip and
 # variant: mean PSNR / SSIM over the withheld frames of the video, of the blend, of the windows
 # one by one both ways, and the video's exposure verdicts (summary.json `exposures`).
 # Everything is written under OUT_DIR, which must be a new or scratch folder.
@@ -41,13 +43,21 @@ for clip in "${clips[@]}"; do
     "$evfs" video --data="$cam" --frame_step=2 --out="$out/video_${clip}_$variant" --overwrite \
       --progress_interval_s=0 >/dev/null 2>&1
     cameras=$(grep -cv '^#' "$cam/images.txt")
+    b=$(/usr/bin/python3 - "$out/video_${clip}_$variant/summary.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+choice = s.get("log_offset_search")
+settings = dict(item.split("=", 1) for item in s["settings"].split())
+print(choice["chosen"] if choice else settings["log_offset"])
+PY
+)
     instant=() exposure=()
     for (( k = 1; k + 1 < cameras; k += 2 )); do
       for timing in instant middle; do
         single="$out/single_${clip}_${variant}_${k}_$timing"
         "$evfs" reconstruct --data="$cam" --mode=interpolate --first=$((k - 1)) --last=$((k + 1)) \
-          --truth=$k --frame_time=$timing --exposure_s=0.000001 --out="$single" --overwrite \
-          --progress_interval_s=0 >/dev/null 2>&1
+          --truth=$k --frame_time=$timing --exposure_s=0.000001 --log_offset="$b" \
+          --out="$single" --overwrite --progress_interval_s=0 >/dev/null 2>&1
       done
       instant+=("$out/single_${clip}_${variant}_${k}_instant/summary.json")
       exposure+=("$out/single_${clip}_${variant}_${k}_middle/summary.json")
