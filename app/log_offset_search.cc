@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <utility>
+#include <numeric>
 
 #include "evfs/core/parallel.h"
 
@@ -39,14 +39,14 @@ std::vector<ValidationTriplet> ValidationTriplets(int num_frames, const std::vec
 LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,
                                 const std::vector<ValidationTriplet>& triplets, double fallback,
                                 const std::function<double(int triplet, double b)>& squared_error,
-                                int workers) {
+                                int workers, const std::string& without_triplets) {
   LogOffsetChoice choice;
   choice.candidates = candidates;
   choice.triplets = triplets;
   choice.chosen = fallback;
   if (candidates.empty() || triplets.empty()) {
     char line[160];
-    std::snprintf(line, sizeof(line), "b %.3g (no three frames to choose it from)", fallback);
+    std::snprintf(line, sizeof(line), "b %.3g (%s)", fallback, without_triplets.c_str());
     choice.description = line;
     return choice;
   }
@@ -67,21 +67,20 @@ LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,
   choice.psnr.assign(sorted.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<double> error(sorted.size(), -1.0);
   // Solves every triplet of the candidates not solved yet, up to `workers` solves at once.
+  const int num_triplets = static_cast<int>(triplets.size());
   const auto evaluate = [&](const std::vector<size_t>& wanted) {
-    std::vector<std::pair<size_t, int>> solves;  // (candidate, triplet)
+    std::vector<size_t> fresh;
     for (const size_t i : wanted) {
-      if (error[i] >= 0.0) continue;
-      for (int k = 0; k < static_cast<int>(triplets.size()); ++k) solves.emplace_back(i, k);
+      if (error[i] < 0.0) fresh.push_back(i);
     }
-    std::vector<double> errors(solves.size());
-    ParallelForEach(static_cast<int>(solves.size()), workers, [&](int n) {
-      errors[n] = squared_error(solves[n].second, sorted[solves[n].first]);
+    std::vector<double> errors(fresh.size() * num_triplets);  // candidate-major
+    ParallelForEach(static_cast<int>(errors.size()), workers, [&](int n) {
+      errors[n] = squared_error(n % num_triplets, sorted[fresh[n / num_triplets]]);
     });
-    for (size_t n = 0; n < solves.size(); ++n) {
-      const size_t i = solves[n].first;
-      error[i] = std::max(error[i], 0.0) + errors[n] / static_cast<double>(triplets.size());
-    }
-    for (const size_t i : wanted) {
+    for (size_t f = 0; f < fresh.size(); ++f) {
+      const auto first = errors.begin() + static_cast<std::ptrdiff_t>(f * num_triplets);
+      const size_t i = fresh[f];
+      error[i] = std::accumulate(first, first + num_triplets, 0.0) / num_triplets;
       choice.psnr[i] = error[i] > 0.0 ? -10.0 * std::log10(error[i]) : 99.0;
     }
   };
@@ -208,7 +207,8 @@ bool SearchesLogOffset(const MethodOptions& method) {
 LogOffsetChoice ChooseLogOffsetOn(const std::vector<double>& candidates,
                                   const std::vector<ValidationTriplet>& triplets,
                                   const std::vector<ValidationScene>& scenes,
-                                  const MethodOptions& method, int threads) {
+                                  const MethodOptions& method, int threads,
+                                  const std::string& without_triplets) {
   // One thread a solve: a 64 px problem gains nothing from a second one (shapes 18,20→19's
   // search took 2.2 s with two threads a solve, 0.9 s with its two triplets side by side).
   MethodOptions trial = method;
@@ -217,7 +217,8 @@ LogOffsetChoice ChooseLogOffsetOn(const std::vector<double>& candidates,
   iterations = std::min(iterations, kValidationMaxIterations);
   return ChooseLogOffset(
       candidates, triplets, method.reconstruction.objective.event_model.log_offset,
-      [&](int k, double b) { return ValidationError(scenes[k], trial, b); }, threads);
+      [&](int k, double b) { return ValidationError(scenes[k], trial, b); }, threads,
+      without_triplets);
 }
 
 }  // namespace evfs

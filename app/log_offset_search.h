@@ -53,14 +53,14 @@ struct LogOffsetChoice {
 /// middle frame of triplets[k] interpolated with b) and keeps the least total. It starts at the
 /// candidate nearest `fallback` and moves to a neighbour while that one has less error (the error
 /// taken to have one minimum over b), so a minimum at one end is found after the candidates
-/// between. Without triplets or candidates `fallback` is kept; a single candidate is chosen
-/// without a solve. Each step solves the candidates
-/// around the current one that are not solved yet (three at the start, then one), every triplet
-/// of each, up to `workers` solves at once (squared_error must allow it).
-LogOffsetChoice ChooseLogOffset(const std::vector<double>& candidates,
-                                const std::vector<ValidationTriplet>& triplets, double fallback,
-                                const std::function<double(int triplet, double b)>& squared_error,
-                                int workers = 1);
+/// between. Without triplets or candidates `fallback` is kept, the description saying
+/// `without_triplets`; a single candidate is chosen without a solve. Each step solves the
+/// candidates around the current one that are not solved yet (three at the start, then one),
+/// every triplet of each, up to `workers` solves at once (squared_error must allow it).
+LogOffsetChoice ChooseLogOffset(
+    const std::vector<double>& candidates, const std::vector<ValidationTriplet>& triplets,
+    double fallback, const std::function<double(int triplet, double b)>& squared_error,
+    int workers = 1, const std::string& without_triplets = "no three frames to choose it from");
 
 /// A square of the sensor, in pixels.
 struct PixelBox {
@@ -98,11 +98,13 @@ bool SearchesLogOffset(const MethodOptions& method);
 
 /// ChooseLogOffset on `scenes` (one per triplet, the same order) with ValidationError, starting
 /// from the b of `method`, each solve on one thread and of at most kValidationMaxIterations
-/// iterations, up to `threads` solves at once. The caller sets `seconds`.
+/// iterations, up to `threads` solves at once; `without_triplets` says why there is nothing to
+/// choose on when `triplets` is empty. The caller sets `seconds`.
 LogOffsetChoice ChooseLogOffsetOn(const std::vector<double>& candidates,
                                   const std::vector<ValidationTriplet>& triplets,
                                   const std::vector<ValidationScene>& scenes,
-                                  const MethodOptions& method, int threads);
+                                  const MethodOptions& method, int threads,
+                                  const std::string& without_triplets);
 
 /// The values of b the command line tries by default (--log_offset_search): the model's default
 /// 0.5 and two on each side of it, each about three times the one before.

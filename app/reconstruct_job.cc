@@ -287,7 +287,8 @@ MethodOptions SearchedMethod(const DataSource& source, const ReconstructRequest&
                                          kValidationSquarePx));
   }
   LogOffsetChoice choice = ChooseLogOffsetOn(request.log_offset_search, triplets, scenes, method,
-                                             method.reconstruction.solver.num_threads);
+                                             method.reconstruction.solver.num_threads,
+                                             "no three frames to choose it from");
   choice.seconds = SecondsSince(start);
   method.reconstruction.objective.event_model.log_offset = choice.chosen;
   result->log_offset_choice = std::move(choice);

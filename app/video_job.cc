@@ -651,14 +651,8 @@ void SearchLogOffset(const std::vector<VideoWindow>& windows, const SharedSource
                                          b.end_ns, request.binning, kValidationSquarePx));
   }
   LogOffsetChoice choice =
-      ChooseLogOffsetOn(request.log_offset_search, triplets, scenes, request.method, threads);
-  if (triplets.empty()) {
-    char line[128];
-    std::snprintf(line, sizeof(line),
-                  "b %.3g (no two neighbouring interpolation windows between sharp frames)",
-                  choice.chosen);
-    choice.description = line;
-  }
+      ChooseLogOffsetOn(request.log_offset_search, triplets, scenes, request.method, threads,
+                        "no two neighbouring interpolation windows between sharp frames");
   choice.seconds = SecondsSince(start);
   result->log_offset_choice = std::move(choice);
 }
